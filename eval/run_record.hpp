@@ -1,0 +1,80 @@
+// What one run leaves for evaluation: per-step truth and estimates, the landmarks the filter
+// initialised with their truth, and the outlier bookkeeping. The pipeline (app/) fills it;
+// metrics.hpp turns it into the paper's tables (DESIGN.md §7) and writers.hpp into files.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace wingman::eval {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct AgentStep {
+  Eigen::Vector3d p_true = Eigen::Vector3d::Zero(), v_true = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p_est = Eigen::Vector3d::Zero(), v_est = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p_sigma = Eigen::Vector3d::Zero();  // sqrt of diag of the position covariance
+};
+
+struct StepRecord {
+  int k = 0;
+  double t = 0;
+  int phase = -1;                // index into RunRecord::phases, -1 outside every phase
+  std::vector<AgentStep> agents;  // same order as RunRecord::agent_names
+  double nees = kNaN;             // eq. 67 over agents' positions and velocities
+  int nees_dof = 0;
+  int landmarks = 0;              // in the state after this step
+  int landmarks_visible = 0;      // predicted in view of some camera
+  int matches_offered = 0;        // landmark correspondences given to the filter
+  int matches_accepted = 0;
+  int initialised = 0;            // landmarks added this step
+  double t_predict_ms = 0, t_update_ms = 0, t_init_ms = 0;
+};
+
+struct LandmarkRecord {
+  std::int64_t id = 0;
+  Eigen::Vector3d truth = Eigen::Vector3d::Zero();
+  double t_init = 0;
+  int init_phase = -1;
+  Eigen::Vector3d est_init = Eigen::Vector3d::Zero();
+  // Estimate at the end of the phase it was initialised in (or when removed, if earlier).
+  Eigen::Vector3d est_phase_end = Eigen::Vector3d::Zero();
+  // Estimate at the end of the run (or when removed).
+  Eigen::Vector3d est_final = Eigen::Vector3d::Zero();
+  double t_removed = kNaN;  // NaN while still in the map at the end
+  std::string origin;       // "cooperative" or "inverse_depth"
+};
+
+// Table 3 bookkeeping for one channel: "uav1", "uav2", ... or "cooperative".
+struct OutlierCounts {
+  std::string channel;
+  long correspondences = 0;     // produced by the frontend (or the synthetic source)
+  long injected = 0;            // synthetic outliers injected (0 with real matching)
+  long outliers = 0;            // correspondences > 3 px from the true projection
+  long accepted = 0;            // correspondences the filter accepted
+  long outliers_accepted = 0;   // outliers among those
+};
+
+struct PhaseInfo {
+  std::string name;
+  double t_start = 0, t_end = 0;
+  std::string config;  // "1", "2", "3", "integrated"
+};
+
+struct RunRecord {
+  std::string scenario_path, scenario_name, variant;
+  std::string estimator_mode;  // "multi" or "single"
+  std::uint64_t seed = 0;
+  std::string software_version;
+  std::vector<std::string> agent_names;  // "lead", "uav1", "uav2", ...
+  std::vector<PhaseInfo> phases;
+  std::vector<StepRecord> steps;
+  std::vector<LandmarkRecord> landmarks;
+  std::vector<OutlierCounts> outliers;
+  double wall_time_s = 0;
+};
+
+}  // namespace wingman::eval
