@@ -1,0 +1,142 @@
+#include "slam/estimator.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "slam/ekf_update.hpp"
+#include "slam/motion_model.hpp"
+
+namespace wingman::slam {
+
+Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
+                     const std::vector<AgentInit>& camera_init, const EstimatorSettings& settings)
+    : cams_(std::move(cameras)),
+      cfg_(settings),
+      s_(static_cast<int>(cams_.size())),
+      rng_(settings.seed) {
+  if (camera_init.size() != cams_.size())
+    throw std::invalid_argument("Estimator: one initial state per camera");
+  const double sp2 = cfg_.initial_position_sigma * cfg_.initial_position_sigma;
+  const double sv2 = cfg_.initial_velocity_sigma * cfg_.initial_velocity_sigma;
+  auto set = [&](int pos, const AgentInit& a) {
+    s_.x.segment<3>(pos) = a.position;
+    s_.x.segment<3>(pos + 3) = a.velocity;
+    s_.P.block<3, 3>(pos, pos).diagonal().setConstant(sp2);
+    s_.P.block<3, 3>(pos + 3, pos + 3).diagonal().setConstant(sv2);
+  };
+  set(FilterState::lead_pos(), lead);
+  for (size_t j = 0; j < cams_.size(); ++j) set(FilterState::cam_pos(static_cast<int>(j)), camera_init[j]);
+  cfg_.visual.sigma_px = cfg_.pixel_sigma;
+  cfg_.visual.gate_probability = cfg_.gate_probability;
+  cfg_.cooperative.sigma_px = cfg_.pixel_sigma;
+  cfg_.inverse_depth.sigma_px = cfg_.pixel_sigma;
+}
+
+void Estimator::predict(double dt) {
+  predict_constant_velocity(s_, dt, cfg_.accel_sigma_lead, cfg_.accel_sigma_uav);
+}
+
+std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
+  std::vector<LandmarkPrediction> out;
+  const CameraRig& rig = cams_[cam];
+  for (const auto& lm : s_.landmarks()) {
+    auto uv = predict_landmark_pixel(s_.x, lm, cam, rig);
+    if (!uv || !rig.model.in_image(*uv, cfg_.image_margin_px)) continue;
+    auto m = landmark_measurement(s_, lm, cam, rig, *uv, cfg_.pixel_sigma);
+    if (!m) continue;
+    out.push_back({lm.id, *uv, innovation_covariance(s_, *m)});
+    tracks_[lm.id].expected = true;
+  }
+  return out;
+}
+
+VisualUpdateResult Estimator::update_landmarks(const std::vector<Correspondence>& candidates) {
+  VisualUpdateResult r = update_with_correspondences(s_, cams_, candidates, cfg_.visual, rng_);
+  for (size_t i = 0; i < candidates.size(); ++i)
+    if (r.accepted[i]) tracks_[candidates[i].id].matched = true;
+  return r;
+}
+
+SensorUpdateResult Estimator::update_sensors(const SensorBatch& b) {
+  std::vector<Measurement> ms;
+  if (b.gps) ms.push_back(gps_measurement(s_, *b.gps, cfg_.gps_sigma));
+  for (const auto& [cam, uv] : b.lead_pixels)
+    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.pixel_sigma))
+      ms.push_back(std::move(*m));
+  for (const auto& [cam, z] : b.altimeter)
+    ms.push_back(altimeter_measurement(s_, cam, cams_[cam], z, cfg_.altimeter_sigma));
+  for (const auto& [cam, z] : b.range)
+    ms.push_back(range_measurement(s_, cam, cams_[cam], z, cfg_.range_sigma));
+  SensorUpdateResult r;
+  r.offered = static_cast<int>(ms.size());
+  if (ms.empty()) return r;
+  const auto ok = update_with_gated_measurements(s_, ms, cfg_.gate_probability);
+  r.accepted = static_cast<int>(std::count(ok.begin(), ok.end(), true));
+  return r;
+}
+
+bool Estimator::make_room() {
+  if (num_landmarks() < cfg_.max_landmarks) return true;
+  // Oldest landmark not expected in any camera this step: it has left the view.
+  for (const auto& lm : s_.landmarks()) {
+    auto it = tracks_.find(lm.id);
+    if (it == tracks_.end() || !it->second.expected) {
+      forget(lm.id);
+      return true;
+    }
+  }
+  return false;
+}
+
+void Estimator::forget(LandmarkId id) {
+  s_.remove_landmark(id);
+  tracks_.erase(id);
+  evicted_.push_back(id);
+}
+
+std::vector<InitOutcome> Estimator::initialise_from_matches(const std::vector<CrossMatch>& matches) {
+  std::vector<InitOutcome> out;
+  out.reserve(matches.size());
+  for (const auto& m : matches) {
+    if (!make_room()) {
+      out.push_back({std::nullopt, "map full"});
+      continue;
+    }
+    auto r = initialise_cooperative(s_, m.cam_a, cams_[m.cam_a], m.uv_a, m.cam_b, cams_[m.cam_b],
+                                    m.uv_b, cfg_.cooperative);
+    if (r.id) tracks_[*r.id].matched = true;  // seen now: no miss on its first step
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+InitOutcome Estimator::initialise_from_pixel(int cam, const Eigen::Vector2d& uv) {
+  if (!make_room()) return {std::nullopt, "map full"};
+  auto r = initialise_inverse_depth(s_, cam, cams_[cam], uv, cfg_.inverse_depth);
+  if (r.id) tracks_[*r.id].matched = true;
+  return r;
+}
+
+std::vector<LandmarkId> Estimator::end_step() {
+  std::vector<LandmarkId> drop;
+  for (auto& [id, t] : tracks_) {
+    if (t.expected && !t.matched) ++t.misses;
+    if (t.matched) t.misses = 0;
+    if (t.misses >= cfg_.max_misses) drop.push_back(id);
+    t.expected = t.matched = false;
+  }
+  std::sort(drop.begin(), drop.end());
+  for (LandmarkId id : drop) forget(id);
+  for (int j = 0; j < num_cameras(); ++j) convert_linear_landmarks(s_, j, cfg_.linearity_threshold);
+  std::vector<LandmarkId> removed;
+  removed.swap(evicted_);
+  return removed;
+}
+
+std::optional<Eigen::Vector3d> Estimator::landmark_position(LandmarkId id) const {
+  const LandmarkSlot* lm = s_.find(id);
+  if (!lm) return std::nullopt;
+  return s_.landmark_position(*lm);
+}
+
+}  // namespace wingman::slam

@@ -1,0 +1,154 @@
+#include "slam/landmark_init.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "slam/inverse_depth.hpp"
+
+namespace wingman::slam {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+// Ideal (undistorted) pixel of a measured pixel, and d ideal / d measured.
+Eigen::Vector2d ideal_pixel(const geometry::PinholeCamera& cam, const Eigen::Vector2d& uv,
+                            Eigen::Matrix2d* J) {
+  const Eigen::Vector2d xn = cam.unproject_normalised(uv);
+  const Eigen::Matrix2d F = Eigen::Vector2d(cam.fx(), cam.fy()).asDiagonal();
+  if (J) {
+    Eigen::Matrix2d Jd;
+    cam.distort_normalised(xn, &Jd);
+    *J = F * Jd.inverse();
+  }
+  return F * xn + Eigen::Vector2d(cam.cx(), cam.cy());
+}
+}  // namespace
+
+std::optional<Triangulation> triangulate_two_views(const CameraRig& cam_a, const Eigen::Vector3d& x_a,
+                                                   const Eigen::Vector2d& uv_a,
+                                                   const CameraRig& cam_b, const Eigen::Vector3d& x_b,
+                                                   const Eigen::Vector2d& uv_b) {
+  const CameraRig* rigs[2] = {&cam_a, &cam_b};
+  const Eigen::Vector3d* xs[2] = {&x_a, &x_b};
+  const Eigen::Vector2d* uvs[2] = {&uv_a, &uv_b};
+  // eq. 50-51 with M = K R [I | -x_c]: each row r of D satisfies r X = r x_c, so b = D x_c.
+  Eigen::Matrix<double, 4, 3> D;
+  Eigen::Vector4d b;
+  Eigen::Matrix3d A[2];
+  Eigen::Vector2d ideal[2];
+  Eigen::Matrix2d J_ideal[2];
+  for (int c = 0; c < 2; ++c) {
+    A[c] = rigs[c]->model.K() * rigs[c]->R_CW;
+    ideal[c] = ideal_pixel(rigs[c]->model, *uvs[c], &J_ideal[c]);
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::RowVector3d row = A[c].row(2) * ideal[c](k) - A[c].row(k);
+      D.row(2 * c + k) = row;
+      b(2 * c + k) = row * (*xs[c]);
+    }
+  }
+  const Eigen::Matrix3d G = D.transpose() * D;
+  const Eigen::FullPivLU<Eigen::Matrix3d> lu(G);
+  if (!lu.isInvertible() || lu.rcond() < 1e-12) return std::nullopt;
+  const Eigen::Matrix3d Gi = lu.inverse();
+  Triangulation t;
+  t.point = Gi * D.transpose() * b;  // eq. 49
+  const Eigen::Vector4d e = b - D * t.point;
+
+  // d X = G^-1 [dD^T e + D^T (db - dD X)], evaluated per parameter.
+  for (int c = 0; c < 2; ++c) {
+    const Eigen::Matrix<double, 2, 3> Dc = D.middleRows<2>(2 * c);
+    t.J.block<3, 3>(0, 3 * c) = Gi * Dc.transpose() * Dc;  // camera position
+    Eigen::Matrix<double, 3, 2> d_ideal;
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector3d a3 = A[c].row(2).transpose();
+      const double de_dp = a3.dot(*xs[c] - t.point);
+      d_ideal.col(k) = Gi * (a3 * e(2 * c + k) + D.row(2 * c + k).transpose() * de_dp);
+    }
+    t.J.block<3, 2>(0, 6 + 2 * c) = d_ideal * J_ideal[c];
+  }
+
+  const Eigen::Vector3d ra = (x_a - t.point).normalized(), rb = (x_b - t.point).normalized();
+  t.parallax_rad = std::acos(std::clamp(ra.dot(rb), -1.0, 1.0));
+  for (int c = 0; c < 2; ++c) {
+    auto uv = project_point(*rigs[c], *xs[c], t.point);
+    t.reprojection_px = std::max(t.reprojection_px, uv ? (*uv - *uvs[c]).norm() : INFINITY);
+  }
+  return t;
+}
+
+InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& rig_a,
+                                   const Eigen::Vector2d& uv_a, int cam_b, const CameraRig& rig_b,
+                                   const Eigen::Vector2d& uv_b, const CooperativeInitSettings& cfg) {
+  const int pa = FilterState::cam_pos(cam_a), pb = FilterState::cam_pos(cam_b);
+  const Eigen::Vector3d x_a = s.x.segment<3>(pa), x_b = s.x.segment<3>(pb);
+  auto t = triangulate_two_views(rig_a, x_a, uv_a, rig_b, x_b, uv_b);
+  if (!t) return {std::nullopt, "degenerate"};
+  if ((rig_a.R_CW * (t->point - x_a)).z() <= 0 || (rig_b.R_CW * (t->point - x_b)).z() <= 0)
+    return {std::nullopt, "negative depth"};
+  if (t->parallax_rad < cfg.min_parallax_deg * kPi / 180) return {std::nullopt, "low parallax"};
+  if (!(t->reprojection_px <= cfg.max_reprojection_px)) return {std::nullopt, "reprojection"};
+
+  // eq. 52: P_new = J diag(P, R) J^T with J = [d/dx_c^a, d/dx_c^b | d/d(uv_a, uv_b)].
+  const Eigen::Matrix3d Ja = t->J.block<3, 3>(0, 0), Jb = t->J.block<3, 3>(0, 3);
+  const Eigen::Matrix<double, 3, 4> Jz = t->J.rightCols<4>();
+  const Eigen::MatrixXd cross = Ja * s.P.middleRows(pa, 3) + Jb * s.P.middleRows(pb, 3);
+  const Eigen::Matrix3d cov = cross.middleCols(pa, 3) * Ja.transpose() +
+                              cross.middleCols(pb, 3) * Jb.transpose() +
+                              cfg.sigma_px * cfg.sigma_px * Jz * Jz.transpose();
+  return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
+}
+
+Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x_c,
+                                  const Eigen::Vector2d& uv, double rho,
+                                  Eigen::Matrix<double, 6, 5>* J) {
+  const Eigen::Vector2d xn = cam.model.unproject_normalised(uv);
+  const Eigen::Vector3d ray_W = cam.R_CW.transpose() * Eigen::Vector3d(xn.x(), xn.y(), 1.0);
+  Eigen::Matrix<double, 2, 3> Jang;
+  const Eigen::Vector2d ang = inverse_depth_angles(ray_W, &Jang);
+  Vector6d y;
+  y << x_c, ang, rho;
+  if (J) {
+    Eigen::Matrix2d Jd;
+    cam.model.distort_normalised(xn, &Jd);  // d uv / d xn
+    J->setZero();
+    J->block<3, 3>(0, 0).setIdentity();
+    J->block<2, 2>(3, 3) = Jang * cam.R_CW.transpose().leftCols<2>() * Jd.inverse();
+  }
+  return y;
+}
+
+InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& rig,
+                                     const Eigen::Vector2d& uv, const InverseDepthInitSettings& cfg) {
+  const int pc = FilterState::cam_pos(cam);
+  Eigen::Matrix<double, 6, 5> J;
+  const Vector6d y = inverse_depth_from_pixel(rig, s.x.segment<3>(pc), uv, cfg.rho, &J);
+  // The anchor is the camera position: it inherits the camera's rows of P.
+  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(6, s.dim());
+  cross.topRows(3) = s.P.middleRows(pc, 3);
+  Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Zero();
+  cov.topLeftCorner<3, 3>() = s.P.block<3, 3>(pc, pc);
+  const Eigen::Matrix2d Juv = J.block<2, 2>(3, 3);
+  cov.block<2, 2>(3, 3) = cfg.sigma_px * cfg.sigma_px * Juv * Juv.transpose();
+  cov(5, 5) = cfg.sigma_rho * cfg.sigma_rho;
+  return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
+}
+
+int convert_linear_landmarks(FilterState& s, int cam, double threshold) {
+  const Eigen::Vector3d x_c = s.x.segment<3>(FilterState::cam_pos(cam));
+  std::vector<LandmarkId> ready;
+  for (const auto& lm : s.landmarks()) {
+    if (lm.kind != LandmarkKind::InverseDepth) continue;
+    const Vector6d y = s.x.segment<6>(lm.offset);
+    const double sigma_rho = std::sqrt(std::max(0.0, s.P(lm.offset + 5, lm.offset + 5)));
+    if (y(5) > 0 && linearity_index(y, sigma_rho, x_c) < threshold) ready.push_back(lm.id);
+  }
+  for (LandmarkId id : ready) {
+    const LandmarkSlot* lm = s.find(id);
+    Eigen::Matrix<double, 3, 6> J;
+    const Eigen::Vector3d p = inverse_depth_to_point(s.x.segment<6>(lm->offset), &J);
+    s.convert_to_euclidean(id, p, J);
+  }
+  return static_cast<int>(ready.size());
+}
+
+}  // namespace wingman::slam

@@ -1,0 +1,67 @@
+// New landmarks.
+// Multi-UAV (paper section 5.2): a point seen by two cameras at the same instant is triangulated
+// linearly from both projections with the a posteriori camera positions (eq. 47-51), and the state
+// is augmented with the covariance of that function of the camera states and both pixels
+// (eq. 52), cross-covariances included.
+// Single-UAV baseline: undelayed inverse-depth initialisation from one pixel (Montiel et al. 2006).
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "slam/measurement_models.hpp"
+#include "slam/state.hpp"
+
+namespace wingman::slam {
+
+struct Triangulation {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  // d point / d (x_c^a, x_c^b, uv_a, uv_b): 3 x 10.
+  Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();
+  double parallax_rad = 0;
+  double reprojection_px = 0;  // the larger of the two
+};
+
+// eq. 49-51: linear triangulation x = D^+ b from two pixels (distortion removed first), with its
+// analytic Jacobian. Nothing when a pixel cannot be undistorted or D is rank deficient.
+std::optional<Triangulation> triangulate_two_views(const CameraRig& cam_a, const Eigen::Vector3d& x_a,
+                                                   const Eigen::Vector2d& uv_a,
+                                                   const CameraRig& cam_b, const Eigen::Vector3d& x_b,
+                                                   const Eigen::Vector2d& uv_b);
+
+struct CooperativeInitSettings {
+  double sigma_px = 3.0;
+  double min_parallax_deg = 3.0;
+  double max_reprojection_px = 10.0;
+};
+
+// Triangulates, checks depth, parallax and reprojection, and augments the state (eq. 52).
+// Returns the new landmark's id, or the reason it was rejected.
+struct InitOutcome {
+  std::optional<LandmarkId> id;
+  std::string rejected_because;
+};
+InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& rig_a,
+                                   const Eigen::Vector2d& uv_a, int cam_b, const CameraRig& rig_b,
+                                   const Eigen::Vector2d& uv_b, const CooperativeInitSettings& cfg);
+
+struct InverseDepthInitSettings {
+  double sigma_px = 3.0;
+  double rho = 0.05;
+  double sigma_rho = 0.04;
+};
+
+// Inverse-depth parameters of the ray through uv from a camera at x_c, with d y / d(x_c, uv)
+// (6 x 5; rho does not depend on them).
+Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x_c,
+                                  const Eigen::Vector2d& uv, double rho,
+                                  Eigen::Matrix<double, 6, 5>* J = nullptr);
+InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& rig,
+                                     const Eigen::Vector2d& uv, const InverseDepthInitSettings& cfg);
+
+// Converts inverse-depth landmarks whose linearity index (seen from camera `cam`) is below the
+// threshold; returns how many were converted.
+int convert_linear_landmarks(FilterState& s, int cam, double threshold);
+
+}  // namespace wingman::slam

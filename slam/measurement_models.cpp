@@ -1,0 +1,151 @@
+#include "slam/measurement_models.hpp"
+
+#include <cmath>
+
+namespace wingman::slam {
+
+std::optional<Eigen::Vector2d> project_point(const CameraRig& cam, const Eigen::Vector3d& x_c,
+                                             const Eigen::Vector3d& x_a,
+                                             Eigen::Matrix<double, 2, 3>* J_xc,
+                                             Eigen::Matrix<double, 2, 3>* J_xa) {
+  const Eigen::Vector3d p_C = cam.R_CW * (x_a - x_c);  // eq. 4
+  Eigen::Matrix<double, 2, 3> Jp;
+  const bool want = J_xc || J_xa;
+  auto uv = cam.model.project(p_C, want ? &Jp : nullptr);  // eq. 3
+  if (!uv) return std::nullopt;
+  if (want) {
+    const Eigen::Matrix<double, 2, 3> JR = Jp * cam.R_CW;
+    if (J_xa) *J_xa = JR;
+    if (J_xc) *J_xc = -JR;
+  }
+  return uv;
+}
+
+std::optional<Eigen::Vector2d> project_inverse_depth(const CameraRig& cam,
+                                                     const Eigen::Vector3d& x_c, const Vector6d& y,
+                                                     Eigen::Matrix<double, 2, 3>* J_xc,
+                                                     Eigen::Matrix<double, 2, 6>* J_y) {
+  const double rho = y(5);
+  Eigen::Matrix<double, 3, 2> Jm;
+  const Eigen::Vector3d m = inverse_depth_direction(y(3), y(4), &Jm);
+  const Eigen::Vector3d d = y.head<3>() - x_c;
+  // The projection is invariant to scale, so project rho * (point - x_c) and never divide by rho.
+  const Eigen::Vector3d p_C = cam.R_CW * (rho * d + m);
+  Eigen::Matrix<double, 2, 3> Jp;
+  const bool want = J_xc || J_y;
+  auto uv = cam.model.project(p_C, want ? &Jp : nullptr);
+  if (!uv) return std::nullopt;
+  if (want) {
+    const Eigen::Matrix<double, 2, 3> JR = Jp * cam.R_CW;
+    if (J_xc) *J_xc = -rho * JR;
+    if (J_y) {
+      J_y->leftCols<3>() = rho * JR;
+      J_y->middleCols<2>(3) = JR * Jm;
+      J_y->col(5) = JR * d;
+    }
+  }
+  return uv;
+}
+
+double range_model(const Eigen::Vector3d& x_h, const Eigen::Vector3d& x_q,
+                   Eigen::Matrix<double, 1, 3>* J_xh, Eigen::Matrix<double, 1, 3>* J_xq) {
+  const Eigen::Vector3d d = x_h - x_q;
+  const double r = d.norm();
+  if (J_xh) *J_xh = d.transpose() / r;
+  if (J_xq) *J_xq = -d.transpose() / r;
+  return r;
+}
+
+namespace {
+SmallSq isotropic(int dim, double sigma) {
+  SmallSq R(dim, dim);
+  R.setIdentity();
+  R.diagonal().setConstant(sigma * sigma);
+  return R;
+}
+}  // namespace
+
+std::optional<Measurement> landmark_measurement(const FilterState& s, const LandmarkSlot& lm,
+                                                int cam_index, const CameraRig& cam,
+                                                const Eigen::Vector2d& z, double sigma_px) {
+  const Eigen::Vector3d x_c = s.x.segment<3>(FilterState::cam_pos(cam_index));
+  Measurement m;
+  m.z = z;
+  m.R = isotropic(2, sigma_px);
+  Eigen::Matrix<double, 2, 3> J_xc;
+  if (lm.kind == LandmarkKind::Euclidean) {
+    Eigen::Matrix<double, 2, 3> J_xa;
+    auto uv = project_point(cam, x_c, s.x.segment<3>(lm.offset), &J_xc, &J_xa);
+    if (!uv) return std::nullopt;
+    m.h = *uv;
+    m.blocks.push_back({lm.offset, J_xa});
+  } else {
+    Eigen::Matrix<double, 2, 6> J_y;
+    auto uv = project_inverse_depth(cam, x_c, s.x.segment<6>(lm.offset), &J_xc, &J_y);
+    if (!uv) return std::nullopt;
+    m.h = *uv;
+    m.blocks.push_back({lm.offset, J_y});
+  }
+  m.blocks.push_back({FilterState::cam_pos(cam_index), J_xc});
+  return m;
+}
+
+std::optional<Measurement> lead_projection_measurement(const FilterState& s, int cam_index,
+                                                       const CameraRig& cam,
+                                                       const Eigen::Vector2d& z, double sigma_px) {
+  Eigen::Matrix<double, 2, 3> J_xc, J_xh;
+  auto uv = project_point(cam, s.x.segment<3>(FilterState::cam_pos(cam_index)),
+                          s.x.segment<3>(FilterState::lead_pos()), &J_xc, &J_xh);  // eq. 5-6
+  if (!uv) return std::nullopt;
+  Measurement m;
+  m.z = z;
+  m.h = *uv;
+  m.R = isotropic(2, sigma_px);
+  m.blocks.push_back({FilterState::lead_pos(), J_xh});
+  m.blocks.push_back({FilterState::cam_pos(cam_index), J_xc});
+  return m;
+}
+
+Measurement gps_measurement(const FilterState& s, const Eigen::Vector3d& z, double sigma) {
+  Measurement m;  // eq. 7
+  m.z = z;
+  m.h = s.x.segment<3>(FilterState::lead_pos());
+  m.R = isotropic(3, sigma);
+  m.blocks.push_back({FilterState::lead_pos(), Eigen::Matrix3d::Identity()});
+  return m;
+}
+
+Measurement altimeter_measurement(const FilterState& s, int cam_index, const CameraRig& cam,
+                                  double z, double sigma) {
+  Measurement m;  // eq. 8, on the UAV's altitude: camera height minus the offset
+  m.z = SmallVec::Constant(1, z);
+  m.h = SmallVec::Constant(1, s.x(FilterState::cam_pos(cam_index) + 2) - cam.offset.z());
+  m.R = isotropic(1, sigma);
+  m.blocks.push_back({FilterState::cam_pos(cam_index), Eigen::RowVector3d(0, 0, 1)});
+  return m;
+}
+
+Measurement range_measurement(const FilterState& s, int cam_index, const CameraRig& cam, double z,
+                              double sigma) {
+  Eigen::Matrix<double, 1, 3> J_xh, J_xq;
+  const double r = range_model(s.x.segment<3>(FilterState::lead_pos()),
+                               s.x.segment<3>(FilterState::cam_pos(cam_index)) - cam.offset, &J_xh,
+                               &J_xq);  // eq. 9
+  Measurement m;
+  m.z = SmallVec::Constant(1, z);
+  m.h = SmallVec::Constant(1, r);
+  m.R = isotropic(1, sigma);
+  m.blocks.push_back({FilterState::lead_pos(), J_xh});
+  m.blocks.push_back({FilterState::cam_pos(cam_index), J_xq});
+  return m;
+}
+
+std::optional<Eigen::Vector2d> predict_landmark_pixel(const Eigen::VectorXd& x,
+                                                      const LandmarkSlot& lm, int cam_index,
+                                                      const CameraRig& cam) {
+  const Eigen::Vector3d x_c = x.segment<3>(FilterState::cam_pos(cam_index));
+  if (lm.kind == LandmarkKind::Euclidean) return project_point(cam, x_c, x.segment<3>(lm.offset));
+  return project_inverse_depth(cam, x_c, x.segment<6>(lm.offset));
+}
+
+}  // namespace wingman::slam

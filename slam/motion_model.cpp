@@ -1,0 +1,19 @@
+#include "slam/motion_model.hpp"
+
+namespace wingman::slam {
+
+void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav) {
+  auto propagate = [&](int pos, int vel, double sigma_a) {
+    s.x.segment<3>(pos) += dt * s.x.segment<3>(vel);  // eq. 41
+    // A P A^T, eq. 42: rows then columns of the position block gain dt times the velocity's.
+    s.P.middleRows(pos, 3) += dt * s.P.middleRows(vel, 3);
+    s.P.middleCols(pos, 3) += dt * s.P.middleCols(vel, 3);
+    // W Q W^T: white acceleration integrated over dt enters the velocity.
+    s.P.block<3, 3>(vel, vel).diagonal().array() += (sigma_a * dt) * (sigma_a * dt);
+  };
+  propagate(FilterState::lead_pos(), FilterState::lead_vel(), sigma_a_lead);
+  for (int j = 0; j < s.num_cameras(); ++j)
+    propagate(FilterState::cam_pos(j), FilterState::cam_vel(j), sigma_a_uav);
+}
+
+}  // namespace wingman::slam

@@ -1,0 +1,63 @@
+// The filter state of paper eq. 2 and its covariance: x = [x_h, v_h, x_c^1, v_c^1, ..., x_a^i],
+// for any number of cameras. Landmarks are Euclidean (3 parameters, eq. 2) or inverse depth
+// (6 parameters [x0 y0 z0 theta phi rho], Montiel et al. 2006) for the single-UAV baseline.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace wingman::slam {
+
+using LandmarkId = std::int64_t;
+
+enum class LandmarkKind { Euclidean, InverseDepth };
+
+struct LandmarkSlot {
+  LandmarkId id = -1;
+  LandmarkKind kind = LandmarkKind::Euclidean;
+  int offset = 0;  // index of its first parameter in x
+  int dim() const { return kind == LandmarkKind::Euclidean ? 3 : 6; }
+};
+
+class FilterState {
+ public:
+  explicit FilterState(int num_cameras);
+
+  Eigen::VectorXd x;
+  Eigen::MatrixXd P;
+
+  int num_cameras() const { return num_cameras_; }
+  static constexpr int lead_pos() { return 0; }
+  static constexpr int lead_vel() { return 3; }
+  static int cam_pos(int j) { return 6 + 6 * j; }
+  static int cam_vel(int j) { return 9 + 6 * j; }
+  int agent_dim() const { return 6 + 6 * num_cameras_; }  // lead and cameras, pos + vel
+  int dim() const { return static_cast<int>(x.size()); }
+
+  const std::vector<LandmarkSlot>& landmarks() const { return landmarks_; }
+  const LandmarkSlot* find(LandmarkId id) const;
+
+  // Appends a landmark (state augmentation, eq. 52): `value` its parameters, `cross` its
+  // covariance with the existing state (dim x n), `cov` its own covariance.
+  LandmarkId add_landmark(LandmarkKind kind, const Eigen::VectorXd& value,
+                          const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov);
+  // Deletes a landmark's rows and columns.
+  void remove_landmark(LandmarkId id);
+  // Replaces an inverse-depth landmark by its Euclidean form: value xyz and J = d xyz / d y.
+  void convert_to_euclidean(LandmarkId id, const Eigen::Vector3d& xyz,
+                            const Eigen::Matrix<double, 3, 6>& J);
+  // Euclidean position of any landmark (inverse depth converted, eq. of Montiel et al.).
+  Eigen::Vector3d landmark_position(const LandmarkSlot& s) const;
+
+  // Makes P exactly symmetric (called after every update).
+  void symmetrise();
+
+ private:
+  int num_cameras_;
+  std::vector<LandmarkSlot> landmarks_;
+  LandmarkId next_id_ = 0;
+};
+
+}  // namespace wingman::slam
