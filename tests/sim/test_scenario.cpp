@@ -1,0 +1,668 @@
+// Scenario model and strict YAML loader (DESIGN.md §4 Table 1, §8).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "sim/scenario.hpp"
+
+namespace wingman::sim {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::StartsWith;
+
+// Raw string literals start with a newline for readability; drop it so that line 1 is the
+// first line of YAML.
+std::string doc(const char* text) {
+  std::string s(text);
+  if (!s.empty() && s.front() == '\n') s.erase(0, 1);
+  return s;
+}
+
+// 1-based line of the first line containing `needle`.
+int line_of(const std::string& text, const std::string& needle) {
+  const auto pos = text.find(needle);
+  if (pos == std::string::npos) {
+    ADD_FAILURE() << "'" << needle << "' not in the document";
+    return -1;
+  }
+  return 1 +
+         static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(pos), '\n'));
+}
+
+std::string error_of(const std::string& yaml, const std::string& origin = "scn.yaml") {
+  try {
+    parse_scenarios(yaml, origin);
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected a ScenarioError for:\n" << yaml;
+  return "";
+}
+
+std::string at_line(const std::string& text, const std::string& needle,
+                    const std::string& origin = "scn.yaml") {
+  return origin + ":" + std::to_string(line_of(text, needle)) + ":";
+}
+
+const std::string kFull = doc(R"(
+name: paper_synthetic
+duration: 210
+rate: 20
+seed: 7
+measurements: synthetic
+lead:
+  initial_position: [1, 2, 3]
+  gps: true
+  trajectory: {type: lemniscate, scale: 80, omega: 0.02, z_amplitude: 1.5, z_omega: 0.04}
+uavs:
+  - name: uav1
+    initial_position: [-1.5, 0, 15]
+    sees_lead: true
+    altimeter: true
+    range: true
+    camera: {fx: 300, fy: 310, cx: 320, cy: 240, width: 640, height: 480,
+             distortion: [0.1, -0.05, 0.001, 0.002], offset: [0, 0, -0.2]}
+  - name: uav2
+    initial_position: [1.5, 0, 17]
+noise: {pixel_sigma: 2, gps_sigma: 1.0, outlier_fraction: 0.1}
+landmarks: {density: 0.05, margin: 40}
+phases:
+  - {name: config1, from: 0, to: 70, config: 1}
+  - {name: config2, from: 70, to: 140, config: 2, add: [lead_projection], remove: [gps]}
+  - {name: config3, from: 140, to: 210, config: 3}
+outages:
+  - {sensor: gps, from: 105, to: 210, agent: lead}
+  - {sensor: altimeter, from: 10, to: 20}
+estimator:
+  mode: multi
+  single_uav: uav1
+  process_noise: {accel_sigma_lead: 0.1, accel_sigma_uav: 0.2}
+  measurement_noise: {pixel_sigma: 4}
+  initial_sigma: {position: 0.01, velocity: 0.02}
+  gating: {probability: 0.99, one_point_ransac: false, ransac_inlier_px: 3,
+           ransac_success_probability: 0.95, ransac_max_hypotheses: 50}
+  map: {max_landmarks: 200, target_per_camera: 30, max_misses: 7, image_margin_px: 12}
+  initialisation: {min_parallax_deg: 2, max_reprojection_px: 8, inverse_depth_rho: 0.1,
+                   inverse_depth_sigma: 0.05, linearity_threshold: 0.2}
+variants:
+  - name: multi
+    estimator: {mode: multi}
+  - name: single-short
+    seed: 9
+    duration: 100
+    phases:
+      - {from: 0, to: 100, config: integrated}
+    outages: []
+    noise: {pixel_sigma: 5}
+    estimator: {mode: single, gating: {probability: 0.9}}
+)");
+
+TEST(ScenarioYaml, FullDocumentParses) {
+  const auto all = parse_scenarios(kFull, "dir/paper.yaml");
+  ASSERT_EQ(all.size(), 2u);
+  const Scenario& s = all[0];
+  EXPECT_EQ(s.source_path, "dir/paper.yaml");
+  EXPECT_EQ(s.name, "paper_synthetic");
+  EXPECT_EQ(s.variant, "multi");
+  EXPECT_DOUBLE_EQ(s.duration, 210);
+  EXPECT_DOUBLE_EQ(s.rate, 20);
+  EXPECT_DOUBLE_EQ(s.dt(), 0.05);
+  EXPECT_EQ(s.num_steps(), 4200);
+  EXPECT_EQ(s.seed, 7u);
+  EXPECT_EQ(s.lead.initial_position, Eigen::Vector3d(1, 2, 3));
+  EXPECT_DOUBLE_EQ(s.lead.trajectory.scale, 80);
+  EXPECT_DOUBLE_EQ(s.lead.trajectory.z_omega, 0.04);
+  ASSERT_EQ(s.uavs.size(), 2u);
+  EXPECT_EQ(s.uavs[0].name, "uav1");
+  EXPECT_TRUE(s.uavs[0].sees_lead);
+  EXPECT_DOUBLE_EQ(s.uavs[0].camera.fy, 310);
+  EXPECT_EQ(s.uavs[0].camera.width, 640);
+  EXPECT_EQ(s.uavs[0].camera.height, 480);
+  EXPECT_DOUBLE_EQ(s.uavs[0].camera.distortion.k2, -0.05);
+  EXPECT_DOUBLE_EQ(s.uavs[0].camera.distortion.p2, 0.002);
+  EXPECT_DOUBLE_EQ(s.uavs[0].camera.distortion.k3, 0.0);
+  EXPECT_DOUBLE_EQ(s.uavs[0].camera.offset.z(), -0.2);
+  // Given UAVs default to the struct defaults.
+  EXPECT_FALSE(s.uavs[1].sees_lead);
+  EXPECT_FALSE(s.uavs[1].altimeter);
+  EXPECT_FALSE(s.uavs[1].range);
+  EXPECT_DOUBLE_EQ(s.uavs[1].camera.fx, 200.1);
+  EXPECT_DOUBLE_EQ(s.noise.pixel_sigma, 2);
+  EXPECT_DOUBLE_EQ(s.noise.outlier_fraction, 0.1);
+  EXPECT_DOUBLE_EQ(s.noise.range_sigma, 0.5);  // default
+  EXPECT_DOUBLE_EQ(s.field.density, 0.05);
+  EXPECT_DOUBLE_EQ(s.field.height_spread, 2.0);  // default
+  ASSERT_EQ(s.phases.size(), 3u);
+  EXPECT_EQ(s.phases[1].name, "config2");
+  EXPECT_EQ(s.phases[1].config, Config::C2);
+  EXPECT_EQ(s.phases[1].add, std::vector<Sensor>{Sensor::LeadProjection});
+  EXPECT_EQ(s.phases[1].remove, std::vector<Sensor>{Sensor::Gps});
+  EXPECT_EQ(s.phases[2].config, Config::C3);
+  ASSERT_EQ(s.outages.size(), 2u);
+  EXPECT_EQ(s.outages[0].agent, "lead");
+  EXPECT_EQ(s.outages[1].sensor, Sensor::Altimeter);
+  EXPECT_EQ(s.outages[1].agent, "");
+  EXPECT_EQ(s.estimator.mode, EstimatorMode::MultiUav);
+  EXPECT_DOUBLE_EQ(s.estimator.accel_sigma_uav, 0.2);
+  EXPECT_DOUBLE_EQ(s.estimator.pixel_sigma, 4);
+  EXPECT_DOUBLE_EQ(s.estimator.gps_sigma, 1.5);  // default
+  EXPECT_DOUBLE_EQ(s.estimator.initial_velocity_sigma, 0.02);
+  EXPECT_DOUBLE_EQ(s.estimator.gate_probability, 0.99);
+  EXPECT_FALSE(s.estimator.one_point_ransac);
+  EXPECT_EQ(s.estimator.ransac_max_hypotheses, 50);
+  EXPECT_EQ(s.estimator.max_landmarks, 200);
+  EXPECT_EQ(s.estimator.target_landmarks_per_camera, 30);
+  EXPECT_EQ(s.estimator.max_misses, 7);
+  EXPECT_DOUBLE_EQ(s.estimator.min_parallax_deg, 2);
+  EXPECT_DOUBLE_EQ(s.estimator.linearity_threshold, 0.2);
+
+  // The second variant: overrides on top of the base, maps merged key by key.
+  const Scenario& v = all[1];
+  EXPECT_EQ(v.variant, "single-short");
+  EXPECT_EQ(v.name, "paper_synthetic");
+  EXPECT_EQ(v.seed, 9u);
+  EXPECT_DOUBLE_EQ(v.duration, 100);
+  EXPECT_DOUBLE_EQ(v.rate, 20);  // from the base
+  EXPECT_EQ(v.estimator.mode, EstimatorMode::SingleUav);
+  EXPECT_DOUBLE_EQ(v.estimator.gate_probability, 0.9);
+  EXPECT_EQ(v.estimator.ransac_max_hypotheses, 50);  // base gating kept
+  EXPECT_FALSE(v.estimator.one_point_ransac);
+  EXPECT_DOUBLE_EQ(v.noise.pixel_sigma, 5);
+  EXPECT_DOUBLE_EQ(v.noise.gps_sigma, 1.0);  // base noise kept
+  ASSERT_EQ(v.phases.size(), 1u);            // list replaced wholesale
+  EXPECT_EQ(v.phases[0].name, "phase1");
+  EXPECT_EQ(v.phases[0].config, Config::Integrated);
+  EXPECT_TRUE(v.outages.empty());
+  // The base is untouched by the variant.
+  EXPECT_EQ(all[0].phases.size(), 3u);
+}
+
+TEST(ScenarioYaml, MissingSectionsGivePaperDefaults) {
+  const auto all = parse_scenarios("seed: 3\n", "scenes/minimal.yaml");
+  ASSERT_EQ(all.size(), 1u);
+  const Scenario& s = all[0];
+  EXPECT_EQ(s.variant, "");
+  EXPECT_EQ(s.name, "minimal");
+  EXPECT_EQ(s.source_path, "scenes/minimal.yaml");
+  EXPECT_EQ(s.seed, 3u);
+  EXPECT_DOUBLE_EQ(s.duration, 210);
+  EXPECT_DOUBLE_EQ(s.rate, 10);
+  EXPECT_EQ(s.num_steps(), 2100);
+  EXPECT_EQ(s.measurements, MeasurementMode::Synthetic);
+  EXPECT_TRUE(s.lead.gps);
+  EXPECT_EQ(s.lead.trajectory.type, "lemniscate");
+  EXPECT_DOUBLE_EQ(s.lead.trajectory.omega, 0.015);
+  ASSERT_EQ(s.uavs.size(), 2u);
+  EXPECT_EQ(s.uavs[0].name, "uav1");
+  EXPECT_EQ(s.uavs[0].initial_position, Eigen::Vector3d(-1.5, 0, 15));
+  EXPECT_TRUE(s.uavs[0].sees_lead);
+  EXPECT_TRUE(s.uavs[0].altimeter);
+  EXPECT_TRUE(s.uavs[0].range);
+  EXPECT_EQ(s.uavs[1].name, "uav2");
+  EXPECT_EQ(s.uavs[1].initial_position, Eigen::Vector3d(1.5, 0, 17));
+  EXPECT_FALSE(s.uavs[1].sees_lead);
+  EXPECT_FALSE(s.uavs[1].altimeter);
+  EXPECT_FALSE(s.uavs[1].range);
+  EXPECT_DOUBLE_EQ(s.uavs[1].camera.fx, 200.1);
+  EXPECT_EQ(s.uavs[1].camera.width, 1000);
+  ASSERT_EQ(s.phases.size(), 1u);
+  EXPECT_EQ(s.phases[0].name, "all");
+  EXPECT_EQ(s.phases[0].config, Config::Integrated);
+  EXPECT_DOUBLE_EQ(s.phases[0].t_start, 0);
+  EXPECT_DOUBLE_EQ(s.phases[0].t_end, 210);
+  EXPECT_TRUE(s.outages.empty());
+  EXPECT_EQ(s.estimator.mode, EstimatorMode::MultiUav);
+  EXPECT_EQ(s.estimator.single_uav, "uav1");
+  EXPECT_DOUBLE_EQ(s.estimator.gate_probability, 0.999);
+  EXPECT_EQ(s.estimator.max_landmarks, 150);
+  EXPECT_DOUBLE_EQ(s.noise.outlier_max_px, 15);
+  EXPECT_DOUBLE_EQ(s.field.density, 0.02);
+}
+
+TEST(ScenarioYaml, DefaultPhaseFollowsVariantDuration) {
+  const auto all = parse_scenarios(doc(R"(
+duration: 50
+variants:
+  - {name: a}
+  - {name: b, duration: 20}
+)"),
+                                   "x.yaml");
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_DOUBLE_EQ(all[0].phases.at(0).t_end, 50);
+  EXPECT_DOUBLE_EQ(all[1].phases.at(0).t_end, 20);
+  EXPECT_EQ(all[1].num_steps(), 200);
+}
+
+TEST(ScenarioYaml, MisspelledDeepKeyNamesFileLineKeyAndSuggestion) {
+  const std::string y = doc(R"(
+duration: 100
+estimator:
+  mode: multi
+  gating:
+    one_point_ransac: true
+    probabilty: 0.99
+)");
+  const std::string msg = error_of(y);
+  EXPECT_EQ(msg,
+            "scn.yaml:6:5: estimator.gating.probabilty: unknown key 'probabilty' "
+            "(did you mean 'probability'?)");
+  EXPECT_THAT(msg, StartsWith(at_line(y, "probabilty")));
+}
+
+TEST(ScenarioYaml, UnknownKeyWithoutCloseMatchHasNoSuggestion) {
+  const std::string msg = error_of("noise: {pixel_sigma: 1, banana: 2}\n");
+  EXPECT_THAT(msg, HasSubstr("scn.yaml:1:25: noise.banana: unknown key 'banana'"));
+  EXPECT_THAT(msg, Not(HasSubstr("did you mean")));
+  EXPECT_THAT(error_of("durration: 3\n"), HasSubstr("(did you mean 'duration'?)"));
+}
+
+TEST(ScenarioYaml, WrongTypesNameLineAndKey) {
+  EXPECT_EQ(error_of("duration: 10\nrate: abc\n"),
+            "scn.yaml:2:7: rate: expected a number, got 'abc'");
+  const std::string y = doc(R"(
+uavs:
+  - name: a
+  - name: b
+    camera:
+      fx: fast
+)");
+  EXPECT_EQ(error_of(y), "scn.yaml:5:11: uavs[1].camera.fx: expected a number, got 'fast'");
+  EXPECT_EQ(error_of("lead: {gps: maybe}\n"),
+            "scn.yaml:1:13: lead.gps: expected true or false, got 'maybe'");
+  EXPECT_THAT(error_of("lead:\n  initial_position: [1, 2]\n"),
+              HasSubstr("scn.yaml:2:21: lead.initial_position: expected a list of 3 numbers"));
+  EXPECT_THAT(error_of("lead:\n  initial_position: [1, x, 2]\n"),
+              HasSubstr("scn.yaml:2:25: lead.initial_position[1]: expected a number, got 'x'"));
+  EXPECT_THAT(error_of("estimator:\n  map: {max_misses: 2.5}\n"),
+              HasSubstr("scn.yaml:2:21: estimator.map.max_misses: expected an integer, got '2.5'"));
+  EXPECT_THAT(error_of("seed: 1.5\n"), HasSubstr("seed: expected an integer"));
+  EXPECT_THAT(error_of("noise:\n  pixel_sigma: 1\nnoise:\n"),
+              HasSubstr("scn.yaml:3:1: noise: duplicate key 'noise' (first at line 1)"));
+  EXPECT_THAT(error_of("estimator:\n  gating: {probability: }\n"),
+              HasSubstr("scn.yaml:2:12: estimator.gating.probability: expected a number, got "
+                        "nothing"));
+  EXPECT_THAT(
+      error_of("phases:\n  - {from: 0, to: 10, config: 1, add: gps}\n"),
+      HasSubstr("scn.yaml:2:39: phases[0].add: expected a list of sensor names, got 'gps'"));
+  EXPECT_THAT(error_of("noise: [1, 2]\n"),
+              HasSubstr("scn.yaml:1:8: noise: expected a map, got a list"));
+  EXPECT_THAT(error_of("duration:\n"),
+              HasSubstr("scn.yaml:1:1: duration: expected a number, got nothing"));
+  EXPECT_THAT(error_of("uavs:\n  - name: a\n    camera: {distortion: [1, 2, 3]}\n  - name: b\n"),
+              HasSubstr("scn.yaml:3:26: uavs[0].camera.distortion: expected a list of 4 or 5"));
+  EXPECT_THAT(
+      error_of("phases:\n  - {from: 0, to: 210, config: 4}\n"),
+      HasSubstr("scn.yaml:2:32: phases[0].config: expected 1, 2, 3 or integrated, got '4'"));
+  EXPECT_THAT(error_of("phases:\n  - {from: 0, to: 210, config: 1, add: [gsp]}\n"),
+              HasSubstr("phases[0].add[0]: unknown sensor 'gsp' (did you mean 'gps'?)"));
+  EXPECT_THAT(error_of("estimator: {mode: solo}\n"),
+              HasSubstr("estimator.mode: expected multi or single, got 'solo'"));
+  EXPECT_THAT(error_of("measurements: rendered\n"),
+              HasSubstr("scn.yaml:1:15: measurements: unknown measurement mode 'rendered'"));
+  EXPECT_THAT(error_of("lead: {trajectory: {type: circle}}\n"),
+              HasSubstr("lead.trajectory.type: unknown trajectory type 'circle'"));
+}
+
+TEST(ScenarioYaml, ValuesOutOfRange) {
+  const std::string y = doc(R"(
+estimator:
+  gating:
+    probability: 1.0
+)");
+  EXPECT_EQ(error_of(y), "scn.yaml:3:18: estimator.gating.probability: must be in (0, 1), got 1.0");
+  EXPECT_THAT(error_of("duration: 0\n"), HasSubstr("scn.yaml:1:11: duration: must be > 0, got 0"));
+  EXPECT_THAT(error_of("rate: 0\n"), HasSubstr("rate: must be in (0, 1000], got 0"));
+  EXPECT_THAT(error_of("rate: 1001\n"), HasSubstr("rate: must be in (0, 1000], got 1001"));
+  EXPECT_NO_THROW(parse_scenarios("rate: 1000\n", "x.yaml"));
+  EXPECT_THAT(error_of("seed: -1\n"), HasSubstr("seed: must be >= 0, got -1"));
+  EXPECT_EQ(parse_scenarios("seed: 18446744073709551615\n", "x.yaml")[0].seed,
+            18446744073709551615ull);
+  EXPECT_THAT(error_of("noise: {gps_sigma: -0.1}\n"), HasSubstr("noise.gps_sigma: must be >= 0"));
+  EXPECT_THAT(error_of("noise: {outlier_fraction: 1.5}\n"),
+              HasSubstr("noise.outlier_fraction: must be in [0, 1], got 1.5"));
+  EXPECT_THAT(error_of("landmarks: {density: 0}\n"), HasSubstr("landmarks.density: must be > 0"));
+  EXPECT_THAT(error_of("uavs:\n  - {name: a, camera: {width: 0}}\n  - {name: b}\n"),
+              HasSubstr("uavs[0].camera.width: must be in [1, 16384], got 0"));
+  EXPECT_THAT(error_of("estimator: {initialisation: {min_parallax_deg: 90}}\n"),
+              HasSubstr("estimator.initialisation.min_parallax_deg: must be in [0, 90), got 90"));
+  EXPECT_THAT(error_of("estimator: {map: {max_landmarks: 0}}\n"),
+              HasSubstr("estimator.map.max_landmarks: must be >= 1, got 0"));
+  EXPECT_THAT(error_of("estimator: {map: {max_misses: 99999999999}}\n"),
+              HasSubstr("estimator.map.max_misses: must be at most 2147483647"));
+  EXPECT_THAT(error_of("estimator: {gating: {ransac_max_hypotheses: 0}}\n"),
+              HasSubstr("estimator.gating.ransac_max_hypotheses: must be >= 1"));
+  EXPECT_THAT(error_of("estimator: {initialisation: {inverse_depth_rho: 0}}\n"),
+              HasSubstr("estimator.initialisation.inverse_depth_rho: must be > 0"));
+  EXPECT_THAT(error_of("estimator:\n  map: {max_landmarks: 20, target_per_camera: 25}\n"),
+              HasSubstr("scn.yaml:2:47: estimator.map.target_per_camera: must not exceed "
+                        "max_landmarks (20), got 25"));
+  EXPECT_THAT(error_of("estimator:\n  map: {max_landmarks: 20}\n"),
+              HasSubstr("scn.yaml:2:24: estimator.map.max_landmarks: must be at least "
+                        "target_per_camera (25), got 20"));
+  EXPECT_THAT(error_of("duration: .inf\n"), HasSubstr("duration: expected a number"));
+}
+
+TEST(ScenarioYaml, PhasesMustBeSortedDisjointAndInsideDuration) {
+  const std::string overlap = doc(R"(
+duration: 210
+phases:
+  - {name: a, from: 0, to: 70, config: 1}
+  - {name: b, from: 60, to: 140, config: 2}
+)");
+  const std::string msg = error_of(overlap);
+  EXPECT_THAT(msg, StartsWith("scn.yaml:4:21: phases[1].from: phase 'b' starts at 60, before "
+                              "the previous phase 'a' ends (70)"));
+  EXPECT_THAT(error_of("phases:\n  - {from: 50, to: 40, config: 1}\n"),
+              HasSubstr("scn.yaml:2:20: phases[0].to: must be greater than from (50), got 40"));
+  EXPECT_THAT(error_of("phases:\n  - {from: -1, to: 40, config: 1}\n"),
+              HasSubstr("phases[0].from: must be >= 0, got -1"));
+  EXPECT_THAT(error_of("phases: []\n"), HasSubstr("phases: expected at least one phase"));
+  EXPECT_THAT(error_of("phases:\n  - {to: 40, config: 1}\n"),
+              HasSubstr("scn.yaml:2:5: phases[0]: missing required key 'from'"));
+  EXPECT_THAT(error_of("phases:\n  - {from: 0, to: 40, config: 1, add: [gps], remove: [gps]}\n"),
+              HasSubstr("phases[0].remove[0]: sensor 'gps' is both added and removed"));
+  // Gaps are allowed.
+  EXPECT_NO_THROW(parse_scenarios(
+      "phases:\n  - {from: 0, to: 10, config: 1}\n  - {from: 20, to: 30, config: 2}\n", "x.yaml"));
+
+  // Past the duration: checked after the variant overrides, pointing at the phase's `to`.
+  const std::string past = doc(R"(
+duration: 210
+phases:
+  - {name: a, from: 0, to: 70, config: 1}
+  - {name: b, from: 70, to: 210, config: 2}
+variants:
+  - {name: full}
+  - {name: short, duration: 100}
+)");
+  EXPECT_EQ(error_of(past),
+            "scn.yaml:4:29: phases[1].to: phase 'b' ends at 210, after the scenario's duration "
+            "(100)");
+  std::string fixed = past;
+  fixed.replace(fixed.find("{name: short, duration: 100}"), 28,
+                "{name: short, duration: 100, phases: [{from: 0, to: 100, config: 3}]}");
+  const auto all = parse_scenarios(fixed, "x.yaml");
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_EQ(all[1].phases.size(), 1u);
+}
+
+TEST(ScenarioYaml, VariantErrors) {
+  const std::string y = doc(R"(
+variants:
+  - name: multi
+    estimator: {mode: multi}
+  - name: single
+    estimater: {mode: single}
+)");
+  EXPECT_EQ(error_of(y),
+            "scn.yaml:5:5: variants[1].estimater: unknown key 'estimater' (did you mean "
+            "'estimator'?)");
+  EXPECT_THAT(error_of("variants:\n  - {name: a, rate: 5}\n"),
+              HasSubstr("scn.yaml:2:15: variants[0].rate: unknown key 'rate' (a variant may set "
+                        "only name, seed, duration"));
+  EXPECT_THAT(error_of("variants:\n  - {name: a}\n  - {name: a}\n"),
+              HasSubstr("scn.yaml:3:12: variants[1].name: duplicate variant name 'a' (first at "
+                        "line 2)"));
+  EXPECT_THAT(error_of("variants:\n  - {seed: 2}\n"),
+              HasSubstr("variants[0]: missing required key 'name'"));
+  EXPECT_THAT(error_of("variants:\n  - {name: Big One}\n"),
+              HasSubstr("variants[0].name: variant names must match [a-z0-9_-]+"));
+  EXPECT_THAT(error_of("variants:\n  - {name: a, estimator: {gating: {probability: 2}}}\n"),
+              HasSubstr("variants[0].estimator.gating.probability: must be in (0, 1), got 2"));
+  EXPECT_THAT(error_of("variants: []\n"), HasSubstr("variants: expected at least one variant"));
+}
+
+TEST(ScenarioYaml, CrossFieldChecksAfterVariants) {
+  const std::string single = doc(R"(
+uavs:
+  - {name: a}
+  - {name: b}
+variants:
+  - {name: m}
+  - name: s
+    estimator: {mode: single}
+)");
+  EXPECT_THAT(error_of(single),
+              HasSubstr("scn.yaml:7:23: variants[1].estimator.mode: single mode uses "
+                        "estimator.single_uav, whose default 'uav1' is not a UAV"));
+  EXPECT_THAT(error_of("estimator: {single_uav: uav7}\n"),
+              HasSubstr("scn.yaml:1:25: estimator.single_uav: 'uav7' is not a UAV of this "
+                        "scenario (UAVs: uav1, uav2)"));
+  EXPECT_THAT(error_of("uavs:\n  - {name: uav1}\n"),
+              HasSubstr("scn.yaml:2:3: uavs: the estimator's mode multi (the default) needs at "
+                        "least 2 UAVs, got 1"));
+  EXPECT_THAT(error_of("uavs:\n  - {name: uav1}\nestimator: {mode: multi}\n"),
+              HasSubstr("scn.yaml:3:19: estimator.mode: mode multi needs at least 2 UAVs"));
+  EXPECT_NO_THROW(
+      parse_scenarios("uavs:\n  - {name: uav1}\nestimator: {mode: single}\n", "x.yaml"));
+  EXPECT_THAT(error_of("uavs: []\n"), HasSubstr("uavs: at least one UAV is needed"));
+  EXPECT_THAT(error_of("outages:\n  - {sensor: gps, from: 1, to: 2, agent: uav9}\n"),
+              HasSubstr("scn.yaml:2:42: outages[0].agent: unknown agent 'uav9' (expected lead or "
+                        "one of the UAVs: uav1, uav2)"));
+  EXPECT_THAT(error_of("outages:\n  - {sensor: gps, from: 3, to: 2}\n"),
+              HasSubstr("outages[0].to: must be greater than from (3), got 2"));
+  EXPECT_THAT(error_of("outages:\n  - {sensor: compass, from: 1, to: 2}\n"),
+              HasSubstr("outages[0].sensor: unknown sensor 'compass'"));
+}
+
+TEST(ScenarioYaml, UavNames) {
+  EXPECT_THAT(error_of("uavs:\n  - {name: a}\n  - {name: a}\n"),
+              HasSubstr("scn.yaml:3:12: uavs[1].name: duplicate UAV name 'a' (first at line 2)"));
+  EXPECT_THAT(error_of("uavs:\n  - {name: Uav-1}\n  - {name: b}\n"),
+              HasSubstr("uavs[0].name: UAV names must match [a-z0-9_]+, got 'Uav-1'"));
+  EXPECT_THAT(error_of("uavs:\n  - {name: lead}\n  - {name: b}\n"),
+              HasSubstr("uavs[0].name: 'lead' is reserved"));
+  EXPECT_THAT(error_of("uavs:\n  - {sees_lead: true}\n  - {name: b}\n"),
+              HasSubstr("scn.yaml:2:5: uavs[0]: missing required key 'name'"));
+}
+
+TEST(ScenarioYaml, DuplicateKeys) {
+  EXPECT_EQ(error_of("duration: 10\nrate: 5\nduration: 20\n"),
+            "scn.yaml:3:1: duration: duplicate key 'duration' (first at line 1)");
+  EXPECT_THAT(error_of("estimator:\n  gating:\n    probability: 0.9\n    probability: 0.8\n"),
+              HasSubstr("scn.yaml:4:5: estimator.gating.probability: duplicate key"));
+}
+
+TEST(ScenarioYaml, DocumentShapeAndSyntaxErrors) {
+  const std::string msg = error_of("duration: 10\nnoise: {pixel_sigma: [1, 2\nrate: 5\n");
+  EXPECT_THAT(msg, StartsWith("scn.yaml:"));
+  EXPECT_THAT(msg, HasSubstr("YAML syntax error"));
+  EXPECT_THAT(msg, testing::ContainsRegex("^scn\\.yaml:[23]:[0-9]+: YAML syntax error: "));
+  EXPECT_THAT(error_of("a: b: c\n"), testing::ContainsRegex("^scn\\.yaml:1:[0-9]+: YAML syntax"));
+  EXPECT_EQ(error_of(""), "scn.yaml: empty document: expected a map of scenario settings");
+  EXPECT_THAT(error_of("# only a comment\n"), HasSubstr("empty document"));
+  EXPECT_THAT(error_of("- 1\n- 2\n"),
+              HasSubstr("scn.yaml:1:1: expected a map of scenario settings at the top level, got "
+                        "a list"));
+  EXPECT_THAT(error_of("seed: 1\n---\nseed: 2\n"), HasSubstr("more than one YAML document"));
+}
+
+TEST(ScenarioYaml, LoadFromFile) {
+  const std::string dir = testing::TempDir();
+  const std::string path = dir + "/wingman_scn_test.yaml";
+  {
+    std::ofstream out(path);
+    out << "duration: 30\nvariants:\n  - {name: a}\n  - {name: b, seed: 4}\n";
+  }
+  const auto all = load_scenarios(path);
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_EQ(all[0].source_path, path);
+  EXPECT_EQ(all[1].source_path, path);
+  EXPECT_EQ(all[0].name, "wingman_scn_test");
+  EXPECT_EQ(all[1].variant, "b");
+  EXPECT_EQ(all[1].seed, 4u);
+  EXPECT_DOUBLE_EQ(all[0].duration, 30);
+
+  {
+    std::ofstream out(path);
+    out << "duration: 30\nrate: fast\n";
+  }
+  try {
+    load_scenarios(path);
+    ADD_FAILURE() << "no error";
+  } catch (const ScenarioError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ":2:7: rate: expected a number, got 'fast'");
+  }
+  std::filesystem::remove(path);
+
+  const std::string missing = dir + "/wingman_no_such_scenario.yaml";
+  try {
+    load_scenarios(missing);
+    ADD_FAILURE() << "no error";
+  } catch (const ScenarioError& e) {
+    EXPECT_EQ(std::string(e.what()), missing + ": cannot read scenario: No such file or directory");
+  }
+  EXPECT_THROW(load_scenarios(dir), ScenarioError);
+}
+
+TEST(ScenarioModel, NamesRoundTrip) {
+  for (Sensor s :
+       {Sensor::Landmarks, Sensor::LeadProjection, Sensor::Altimeter, Sensor::Range, Sensor::Gps}) {
+    EXPECT_EQ(sensor_from_string(to_string(s)), s);
+  }
+  EXPECT_STREQ(to_string(Sensor::LeadProjection), "lead_projection");
+  EXPECT_STREQ(to_string(Sensor::Gps), "gps");
+  EXPECT_FALSE(sensor_from_string("GPS").has_value());
+  EXPECT_STREQ(to_string(Config::C1), "1");
+  EXPECT_STREQ(to_string(Config::C3), "3");
+  EXPECT_STREQ(to_string(Config::Integrated), "integrated");
+  EXPECT_STREQ(to_string(EstimatorMode::MultiUav), "multi");
+  EXPECT_STREQ(to_string(EstimatorMode::SingleUav), "single");
+  EXPECT_STREQ(to_string(MeasurementMode::Synthetic), "synthetic");
+}
+
+TEST(ScenarioModel, SensorsOfFollowsTable1) {
+  using S = Sensor;
+  EXPECT_EQ(sensors_of(Config::C1), (std::vector<S>{S::Landmarks, S::LeadProjection, S::Gps}));
+  EXPECT_EQ(sensors_of(Config::C2), (std::vector<S>{S::Landmarks, S::Altimeter, S::Range, S::Gps}));
+  EXPECT_EQ(sensors_of(Config::C3),
+            (std::vector<S>{S::Landmarks, S::LeadProjection, S::Altimeter, S::Range}));
+  EXPECT_EQ(sensors_of(Config::Integrated).size(), 5u);
+}
+
+const std::string kPaper = doc(R"(
+duration: 280
+phases:
+  - {name: c1, from: 0, to: 70, config: 1}
+  - {name: c2, from: 70, to: 140, config: 2}
+  - {name: c3, from: 140, to: 210, config: 3}
+  - {name: all, from: 220, to: 280, config: integrated, add: [], remove: [range]}
+outages:
+  - {sensor: gps, from: 30, to: 40, agent: lead}
+  - {sensor: landmarks, from: 50, to: 60, agent: uav2}
+  - {sensor: lead_projection, from: 240, to: 280}
+)");
+
+TEST(ScenarioModel, PhaseAtBoundaries) {
+  const Scenario s = parse_scenarios(kPaper, "x.yaml").at(0);
+  EXPECT_EQ(s.phase_at(-0.1), -1);
+  EXPECT_EQ(s.phase_at(0.0), 0);
+  EXPECT_EQ(s.phase_at(69.9), 0);
+  EXPECT_EQ(s.phase_at(70.0), 1);
+  EXPECT_EQ(s.phase_at(700 * 0.1), 1);
+  EXPECT_EQ(s.phase_at(139.99), 1);
+  EXPECT_EQ(s.phase_at(140.0), 2);
+  EXPECT_EQ(s.phase_at(209.9), 2);
+  EXPECT_EQ(s.phase_at(210.0), -1);  // gap
+  EXPECT_EQ(s.phase_at(215.0), -1);
+  EXPECT_EQ(s.phase_at(220.0), 3);
+  EXPECT_EQ(s.phase_at(280.0), 3);  // t == duration: the last phase ending there
+  EXPECT_EQ(s.phase_at(280.1), -1);
+
+  // The end of a phase that ends before the duration is not inside it.
+  Scenario t;
+  t.duration = 100;
+  t.phases = {Phase{"a", 0, 50, Config::C1, {}, {}}};
+  EXPECT_EQ(t.phase_at(50.0), -1);
+  EXPECT_EQ(t.phase_at(100.0), -1);
+  t.phases.push_back(Phase{"b", 50, 100, Config::C2, {}, {}});
+  EXPECT_EQ(t.phase_at(50.0), 1);
+  EXPECT_EQ(t.phase_at(100.0), 1);
+  // Accumulated time stamps land on the right side of a boundary.
+  double acc = 0;
+  for (int k = 0; k < 500; ++k) acc += 0.1;
+  EXPECT_EQ(t.phase_at(acc), 1);
+  EXPECT_EQ(Scenario{}.phase_at(0), -1);
+}
+
+TEST(ScenarioModel, SensorActiveTruthTable) {
+  const Scenario s = parse_scenarios(kPaper, "x.yaml").at(0);
+  using S = Sensor;
+  struct Row {
+    double t;
+    S sensor;
+    const char* agent;
+    bool active;
+  };
+  const Row rows[] = {
+      // Config 1: landmarks, lead projection, GPS.
+      {10, S::Landmarks, "uav1", true},
+      {10, S::Landmarks, "uav2", true},
+      {10, S::Landmarks, "lead", false},
+      {10, S::LeadProjection, "uav1", true},
+      {10, S::LeadProjection, "uav2", false},  // uav2 does not see the lead
+      {10, S::Gps, "lead", true},
+      {10, S::Gps, "uav1", false},
+      {10, S::Altimeter, "uav1", false},
+      {10, S::Range, "uav1", false},
+      {35, S::Gps, "lead", false},  // outage on the lead's GPS
+      {40, S::Gps, "lead", true},   // outage window is [30, 40)
+      {30, S::Gps, "lead", false},
+      // Config 2: landmarks, altimeter, range, GPS.
+      {100, S::Landmarks, "uav1", true},
+      {100, S::LeadProjection, "uav1", false},
+      {100, S::Altimeter, "uav1", true},
+      {100, S::Altimeter, "uav2", false},  // uav2 carries no altimeter
+      {100, S::Range, "uav1", true},
+      {100, S::Range, "uav2", false},
+      {100, S::Gps, "lead", true},
+      {55, S::Landmarks, "uav2", false},  // outage for uav2 only
+      {55, S::Landmarks, "uav1", true},
+      // Config 3: landmarks, lead projection, altimeter, range; no GPS.
+      {150, S::Gps, "lead", false},
+      {150, S::LeadProjection, "uav1", true},
+      {150, S::Altimeter, "uav1", true},
+      {150, S::Range, "uav1", true},
+      {150, S::Landmarks, "uav2", true},
+      // Gap between phases: nothing.
+      {215, S::Landmarks, "uav1", false},
+      {215, S::Gps, "lead", false},
+      // Integrated minus range, with a lead-projection outage for everyone from 240 to the end.
+      {230, S::Gps, "lead", true},
+      {230, S::Altimeter, "uav1", true},
+      {230, S::Range, "uav1", false},
+      {230, S::LeadProjection, "uav1", true},
+      {250, S::LeadProjection, "uav1", false},
+      {280, S::LeadProjection, "uav1", false},  // the outage reaches the final step
+      {280, S::Landmarks, "uav1", true},
+      // Unknown agents carry nothing; outside the scenario nothing is active.
+      {10, S::Landmarks, "uav9", false},
+      {-1, S::Landmarks, "uav1", false},
+      {300, S::Landmarks, "uav1", false},
+  };
+  for (const Row& r : rows) {
+    EXPECT_EQ(s.sensor_active(r.sensor, r.t, r.agent), r.active)
+        << "t=" << r.t << " sensor=" << to_string(r.sensor) << " agent=" << r.agent;
+  }
+
+  // A lead without GPS never has it; `add` brings a sensor into a preset.
+  Scenario t = s;
+  t.lead.gps = false;
+  EXPECT_FALSE(t.sensor_active(S::Gps, 10, "lead"));
+  t = s;
+  t.phases[2].add = {S::Gps};
+  EXPECT_TRUE(t.sensor_active(S::Gps, 150, "lead"));
+  t.phases[0].remove = {S::Landmarks};
+  EXPECT_FALSE(t.sensor_active(S::Landmarks, 10, "uav1"));
+  EXPECT_EQ(s.uav_index("uav2"), 1);
+  EXPECT_EQ(s.uav_index("lead"), -1);
+}
+
+}  // namespace
+}  // namespace wingman::sim
