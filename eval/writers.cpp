@@ -1,0 +1,346 @@
+#include "eval/writers.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace wingman::eval {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+void write_file(const fs::path& path, std::string_view content) {
+  if (path.has_parent_path()) fs::create_directories(path.parent_path());
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw std::runtime_error("cannot open '" + path.string() + "' for writing");
+  out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  out.close();
+  if (!out) throw std::runtime_error("failed writing '" + path.string() + "'");
+}
+
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json vec3(const Eigen::Vector3d& v) { return json::array({num(v.x()), num(v.y()), num(v.z())}); }
+
+json agent_error(const AgentError& e) {
+  return {{"mse", vec3(e.mse)}, {"rms_error", num(e.rms_error)},
+          {"max_error", num(e.max_error)}, {"steps", e.steps}};
+}
+
+json landmark_mse(const LandmarkMse& l) {
+  return {{"count", l.count}, {"final_mse", vec3(l.final_mse)}, {"init_mse", vec3(l.init_mse)}};
+}
+
+json stats(const Stats& s) {
+  return {{"mean", num(s.mean)}, {"median", num(s.median)}, {"p95", num(s.p95)},
+          {"max", num(s.max)}, {"count", s.count}};
+}
+
+// CSV cell for a double: shortest text that reads back to the same value; "nan" for NaN.
+void put(fmt::memory_buffer& b, double v) { fmt::format_to(std::back_inserter(b), ",{}", v); }
+void put3(fmt::memory_buffer& b, const Eigen::Vector3d& v) {
+  put(b, v.x());
+  put(b, v.y());
+  put(b, v.z());
+}
+
+// Table cell: value or "-" when undefined.
+std::string cell(double v, int width, int precision = 4) {
+  if (!std::isfinite(v)) return fmt::format("{:>{}}", "-", width);
+  return fmt::format("{:>{}.{}f}", v, width, precision);
+}
+
+std::string phase_name(const RunRecord& run, int p) {
+  return p >= 0 && p < static_cast<int>(run.phases.size()) ? run.phases[p].name
+                                                            : fmt::format("phase {}", p);
+}
+
+}  // namespace
+
+void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& path) {
+  json j;
+  j["software_version"] = run.software_version;
+  j["scenario"] = {{"path", run.scenario_path},       {"name", run.scenario_name},
+                   {"variant", run.variant},          {"seed", run.seed},
+                   {"estimator_mode", run.estimator_mode}};
+  j["agents"] = run.agent_names;
+  json phases = json::array();
+  for (const PhaseInfo& p : run.phases) {
+    phases.push_back({{"name", p.name}, {"t_start", num(p.t_start)}, {"t_end", num(p.t_end)},
+                      {"config", p.config}});
+  }
+  j["phases"] = phases;
+
+  json t4_phases = json::array();
+  for (const Table4Phase& row : m.table4.phases) {
+    json agents = json::object();
+    for (std::size_t a = 0; a < row.agents.size() && a < run.agent_names.size(); ++a) {
+      agents[run.agent_names[a]] = agent_error(row.agents[a]);
+    }
+    t4_phases.push_back({{"phase", row.phase}, {"name", phase_name(run, row.phase)},
+                         {"agents", agents}});
+  }
+  json t4_total = json::object();
+  for (std::size_t a = 0; a < m.table4.total.size() && a < run.agent_names.size(); ++a) {
+    t4_total[run.agent_names[a]] = agent_error(m.table4.total[a]);
+  }
+  j["table4"] = {{"phases", t4_phases}, {"total", t4_total}};
+
+  json t5_phases = json::array();
+  for (std::size_t p = 0; p < m.table5.phases.size(); ++p) {
+    json row = landmark_mse(m.table5.phases[p]);
+    row["phase"] = p;
+    row["name"] = phase_name(run, static_cast<int>(p));
+    t5_phases.push_back(row);
+  }
+  j["table5"] = {{"phases", t5_phases}, {"total", landmark_mse(m.table5.total)}};
+
+  json t3 = json::array();
+  for (const OutlierRow& r : m.table3) {
+    t3.push_back({{"channel", r.counts.channel},
+                  {"correspondences", r.counts.correspondences},
+                  {"injected", r.counts.injected},
+                  {"outliers", r.counts.outliers},
+                  {"accepted", r.counts.accepted},
+                  {"outliers_accepted", r.counts.outliers_accepted},
+                  {"accepted_outlier_fraction", num(r.accepted_outlier_fraction)}});
+  }
+  j["table3"] = t3;
+
+  json per_phase = json::array(), per_step = json::array();
+  for (double v : m.nees.per_phase_mean) per_phase.push_back(num(v));
+  for (double v : m.nees.per_step) per_step.push_back(num(v));
+  j["nees"] = {{"dof", m.nees.dof},
+               {"mean", num(m.nees.mean)},
+               {"per_phase_mean", per_phase},
+               {"per_step", per_step}};
+
+  j["timings_ms"] = {{"predict", stats(m.timings_ms.predict)},
+                     {"update", stats(m.timings_ms.update)},
+                     {"init", stats(m.timings_ms.init)},
+                     {"total", stats(m.timings_ms.total)}};
+  j["landmarks"] = {{"initialised", m.landmarks.initialised},
+                    {"max_in_state", m.landmarks.max_in_state},
+                    {"count_per_step", m.landmarks.count_per_step}};
+  j["wall_time_s"] = num(run.wall_time_s);
+  j["steps"] = run.steps.size();
+  write_file(path, j.dump(2) + "\n");
+}
+
+void write_tum_trajectories(const RunRecord& run, const fs::path& dir) {
+  for (std::size_t a = 0; a < run.agent_names.size(); ++a) {
+    fmt::memory_buffer est, gt;
+    for (auto* b : {&est, &gt}) {
+      fmt::format_to(std::back_inserter(*b), "# timestamp tx ty tz qx qy qz qw\n");
+    }
+    for (const StepRecord& s : run.steps) {
+      if (a >= s.agents.size()) continue;
+      const Eigen::Vector3d& pe = s.agents[a].p_est;
+      const Eigen::Vector3d& pt = s.agents[a].p_true;
+      fmt::format_to(std::back_inserter(est), "{:.9f} {:.9g} {:.9g} {:.9g} 0 0 0 1\n", s.t,
+                     pe.x(), pe.y(), pe.z());
+      fmt::format_to(std::back_inserter(gt), "{:.9f} {:.9g} {:.9g} {:.9g} 0 0 0 1\n", s.t,
+                     pt.x(), pt.y(), pt.z());
+    }
+    write_file(dir / (run.agent_names[a] + ".est.tum"), fmt::to_string(est));
+    write_file(dir / (run.agent_names[a] + ".gt.tum"), fmt::to_string(gt));
+  }
+}
+
+void write_steps_csv(const RunRecord& run, const fs::path& path) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  fmt::format_to(out, "k,t,phase");
+  for (const std::string& a : run.agent_names) {
+    for (const char* q : {"p", "v"}) {
+      for (const char* kind : {"true", "est"}) {
+        for (const char* ax : {"x", "y", "z"}) fmt::format_to(out, ",{}_{}{}_{}", a, q, ax, kind);
+      }
+    }
+    for (const char* ax : {"x", "y", "z"}) fmt::format_to(out, ",{}_s{}", a, ax);
+  }
+  fmt::format_to(out,
+                 ",nees,landmarks,landmarks_visible,matches_offered,matches_accepted,initialised,"
+                 "t_predict_ms,t_update_ms,t_init_ms\n");
+  for (const StepRecord& s : run.steps) {
+    fmt::format_to(out, "{},{},{}", s.k, s.t, s.phase);
+    for (std::size_t a = 0; a < run.agent_names.size(); ++a) {
+      const AgentStep as = a < s.agents.size() ? s.agents[a] : AgentStep{};
+      put3(b, as.p_true);
+      put3(b, as.p_est);
+      put3(b, as.v_true);
+      put3(b, as.v_est);
+      put3(b, as.p_sigma);
+    }
+    put(b, s.nees);
+    fmt::format_to(out, ",{},{},{},{},{}", s.landmarks, s.landmarks_visible, s.matches_offered,
+                   s.matches_accepted, s.initialised);
+    put(b, s.t_predict_ms);
+    put(b, s.t_update_ms);
+    put(b, s.t_init_ms);
+    fmt::format_to(out, "\n");
+  }
+  write_file(path, fmt::to_string(b));
+}
+
+void write_landmarks_csv(const RunRecord& run, const fs::path& path) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  fmt::format_to(out,
+                 "id,truth_x,truth_y,truth_z,init_x,init_y,init_z,phase_end_x,phase_end_y,"
+                 "phase_end_z,final_x,final_y,final_z,t_init,init_phase,t_removed,origin\n");
+  for (const LandmarkRecord& l : run.landmarks) {
+    fmt::format_to(out, "{}", l.id);
+    put3(b, l.truth);
+    put3(b, l.est_init);
+    put3(b, l.est_phase_end);
+    put3(b, l.est_final);
+    put(b, l.t_init);
+    fmt::format_to(out, ",{}", l.init_phase);
+    put(b, l.t_removed);
+    fmt::format_to(out, ",{}\n", l.origin);
+  }
+  write_file(path, fmt::to_string(b));
+}
+
+void write_map_ply(const RunRecord& run, const fs::path& path, MapPoints which) {
+  std::vector<const LandmarkRecord*> kept;
+  for (const LandmarkRecord& l : run.landmarks) {
+    if (std::isnan(l.t_removed)) kept.push_back(&l);
+  }
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  fmt::format_to(out,
+                 "ply\nformat ascii 1.0\ncomment wingman {} map, scenario {}\n"
+                 "comment colour: blue cooperative, orange inverse_depth, grey truth\n"
+                 "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n"
+                 "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
+                 which == MapPoints::truth ? "truth" : "estimated", run.scenario_name,
+                 kept.size());
+  for (const LandmarkRecord* l : kept) {
+    const Eigen::Vector3d& p = which == MapPoints::truth ? l->truth : l->est_final;
+    int r = 160, g = 160, bl = 160;
+    if (which == MapPoints::estimate && l->origin == "cooperative") {
+      r = 31, g = 119, bl = 180;
+    } else if (which == MapPoints::estimate && l->origin == "inverse_depth") {
+      r = 255, g = 127, bl = 14;
+    }
+    fmt::format_to(out, "{:.9g} {:.9g} {:.9g} {} {} {}\n", p.x(), p.y(), p.z(), r, g, bl);
+  }
+  write_file(path, fmt::to_string(b));
+}
+
+void write_results(const Metrics& metrics, const RunRecord& run, const fs::path& dir) {
+  fs::create_directories(dir);
+  write_metrics_json(metrics, run, dir / "metrics.json");
+  write_tum_trajectories(run, dir / "traj");
+  write_steps_csv(run, dir / "steps.csv");
+  write_landmarks_csv(run, dir / "landmarks.csv");
+  write_map_ply(run, dir / "map.ply", MapPoints::estimate);
+  write_map_ply(run, dir / "map_truth.ply", MapPoints::truth);
+}
+
+std::string format_summary(const Metrics& m, const RunRecord& run) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+
+  std::size_t name_w = 5;  // "total"
+  for (const PhaseInfo& p : run.phases) name_w = std::max(name_w, p.name.size());
+  const int nw = static_cast<int>(name_w);
+  const int w = 9;
+
+  fmt::format_to(out, "Scenario {} (variant {}, seed {}, estimator {}), {} steps, {:.1f} s wall\n",
+                 run.scenario_name.empty() ? "-" : run.scenario_name,
+                 run.variant.empty() ? "-" : run.variant, run.seed,
+                 run.estimator_mode.empty() ? "-" : run.estimator_mode, run.steps.size(),
+                 run.wall_time_s);
+
+  // Table 4: MSE per axis, then the error norm (RMS / max) per agent.
+  fmt::format_to(out, "\nTable 4: position MSE [m^2]\n{:<{}}", "phase", nw);
+  for (const std::string& a : run.agent_names) {
+    for (const char* ax : {"X", "Y", "Z"}) {
+      fmt::format_to(out, " {:>{}}", fmt::format("{} {}", a, ax), w);
+    }
+  }
+  fmt::format_to(out, "\n");
+  auto t4_row = [&](const std::string& name, const std::vector<AgentError>& agents) {
+    fmt::format_to(out, "{:<{}}", name, nw);
+    for (const AgentError& e : agents) {
+      for (int i = 0; i < 3; ++i) fmt::format_to(out, " {}", cell(e.mse[i], w));
+    }
+    fmt::format_to(out, "\n");
+  };
+  for (const Table4Phase& row : m.table4.phases) t4_row(phase_name(run, row.phase), row.agents);
+  t4_row("total", m.table4.total);
+
+  fmt::format_to(out, "\nPosition error norm, RMS / max [m]\n{:<{}}", "phase", nw);
+  for (const std::string& a : run.agent_names) {
+    fmt::format_to(out, " {:>{}} {:>{}}", a + " rms", w, a + " max", w);
+  }
+  fmt::format_to(out, "\n");
+  auto norm_row = [&](const std::string& name, const std::vector<AgentError>& agents) {
+    fmt::format_to(out, "{:<{}}", name, nw);
+    for (const AgentError& e : agents) {
+      fmt::format_to(out, " {} {}", cell(e.rms_error, w, 3), cell(e.max_error, w, 3));
+    }
+    fmt::format_to(out, "\n");
+  };
+  for (const Table4Phase& row : m.table4.phases) norm_row(phase_name(run, row.phase), row.agents);
+  norm_row("total", m.table4.total);
+
+  fmt::format_to(out, "\nTable 5: landmark MSE [m^2], end of phase (total: end of run) / at init\n");
+  fmt::format_to(out, "{:<{}} {:>6}", "phase", nw, "count");
+  for (const char* h : {"fin X", "fin Y", "fin Z", "init X", "init Y", "init Z"}) {
+    fmt::format_to(out, " {:>{}}", h, w);
+  }
+  fmt::format_to(out, "\n");
+  auto t5_row = [&](const std::string& name, const LandmarkMse& l) {
+    fmt::format_to(out, "{:<{}} {:>6}", name, nw, l.count);
+    for (int i = 0; i < 3; ++i) fmt::format_to(out, " {}", cell(l.final_mse[i], w));
+    for (int i = 0; i < 3; ++i) fmt::format_to(out, " {}", cell(l.init_mse[i], w));
+    fmt::format_to(out, "\n");
+  };
+  for (std::size_t p = 0; p < m.table5.phases.size(); ++p) {
+    t5_row(phase_name(run, static_cast<int>(p)), m.table5.phases[p]);
+  }
+  t5_row("total", m.table5.total);
+
+  if (!m.table3.empty()) {
+    std::size_t cw = 7;
+    for (const OutlierRow& r : m.table3) cw = std::max(cw, r.counts.channel.size());
+    const int cwi = static_cast<int>(cw);
+    fmt::format_to(out, "\nTable 3: outliers (> 3 px from the true projection)\n");
+    fmt::format_to(out, "{:<{}} {:>10} {:>9} {:>9} {:>10} {:>10} {:>9}\n", "channel", cwi,
+                   "corresp.", "injected", "outliers", "accepted", "out.acc.", "fraction");
+    for (const OutlierRow& r : m.table3) {
+      const OutlierCounts& c = r.counts;
+      fmt::format_to(out, "{:<{}} {:>10} {:>9} {:>9} {:>10} {:>10} {}\n", c.channel, cwi,
+                     c.correspondences, c.injected, c.outliers, c.accepted, c.outliers_accepted,
+                     cell(r.accepted_outlier_fraction, 9));
+    }
+  }
+
+  fmt::format_to(out, "\nNEES mean {} (dof {})", cell(m.nees.mean, 0, 3), m.nees.dof);
+  for (std::size_t p = 0; p < m.nees.per_phase_mean.size(); ++p) {
+    fmt::format_to(out, "{} {} {}", p == 0 ? "; per phase:" : ",",
+                   phase_name(run, static_cast<int>(p)), cell(m.nees.per_phase_mean[p], 0, 3));
+  }
+  const Timings& t = m.timings_ms;
+  fmt::format_to(out,
+                 "\nStep time [ms]: mean {} (predict {}, update {}, init {}), median {}, p95 {}, "
+                 "max {}\n",
+                 cell(t.total.mean, 0, 3), cell(t.predict.mean, 0, 3), cell(t.update.mean, 0, 3),
+                 cell(t.init.mean, 0, 3), cell(t.total.median, 0, 3), cell(t.total.p95, 0, 3),
+                 cell(t.total.max, 0, 3));
+  fmt::format_to(out, "Landmarks: {} initialised, at most {} in the state\n",
+                 m.landmarks.initialised, m.landmarks.max_in_state);
+  return fmt::to_string(b);
+}
+
+}  // namespace wingman::eval

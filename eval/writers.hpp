@@ -1,0 +1,42 @@
+// Writes a run's results in formats other tools read (DESIGN.md §8): metrics.json, TUM
+// trajectories, per-step and landmark CSVs, the map as PLY, and a fixed-width summary for
+// stdout. NaN is written as JSON null and as "nan" in CSV. All writers throw
+// std::runtime_error naming the file if it cannot be written.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "eval/metrics.hpp"
+#include "eval/run_record.hpp"
+
+namespace wingman::eval {
+
+// Every table of compute_metrics plus the scenario, phases and software version.
+void write_metrics_json(const Metrics& metrics, const RunRecord& run,
+                        const std::filesystem::path& path);
+
+// <dir>/<agent>.est.tum and <dir>/<agent>.gt.tum for every agent, one line per step:
+// "timestamp tx ty tz qx qy qz qw" in seconds with an identity quaternion (positions only).
+void write_tum_trajectories(const RunRecord& run, const std::filesystem::path& dir);
+
+// One row per step: k, t, phase, per-agent truth/estimate/sigma, NEES, map and timing columns.
+void write_steps_csv(const RunRecord& run, const std::filesystem::path& path);
+
+// One row per initialised landmark: truth, estimates at init / phase end / end, origin.
+void write_landmarks_csv(const RunRecord& run, const std::filesystem::path& path);
+
+// ASCII PLY of the landmarks still in the map at the end (t_removed NaN): their final
+// estimates coloured by origin (MapPoints::estimate), or their truth points (MapPoints::truth).
+enum class MapPoints { estimate, truth };
+void write_map_ply(const RunRecord& run, const std::filesystem::path& path, MapPoints which);
+
+// Everything above into a results directory: metrics.json, traj/, steps.csv, landmarks.csv,
+// map.ply, map_truth.ply. Plots are separate (plots.hpp) because they need gnuplot.
+void write_results(const Metrics& metrics, const RunRecord& run,
+                   const std::filesystem::path& dir);
+
+// Readable fixed-width tables (Table 4, 5, 3, NEES, timings, map size) for stdout.
+std::string format_summary(const Metrics& metrics, const RunRecord& run);
+
+}  // namespace wingman::eval
