@@ -112,6 +112,9 @@ struct EstimatorSpec {
   double gps_sigma = 1.5;
   double altimeter_sigma = 0.5;
   double range_sigma = 0.5;
+  // Gimbal pointing noise about the camera's x and y axes that the filter assumes (rad); the
+  // truth's gimbal error is never given to it. 0 trusts R_CW exactly.
+  double orientation_sigma = 0.0;
   // Initial uncertainty of the agents (the paper: known exactly).
   double initial_position_sigma = 1e-3;
   double initial_velocity_sigma = 1e-3;

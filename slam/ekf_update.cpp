@@ -12,6 +12,7 @@ Eigen::MatrixXd covariance_times_jacobian(const FilterState& s, const Measuremen
 
 SmallSq innovation_covariance(const FilterState& s, const Measurement& m) {
   SmallSq S = m.R;
+  if (m.camera >= 0) S.noalias() += m.orientation_sigma * m.orientation_sigma * m.V * m.V.transpose();
   for (const auto& a : m.blocks)
     for (const auto& b : m.blocks)
       S.noalias() += a.H * s.P.block(a.col, b.col, a.H.cols(), b.H.cols()) * b.H.transpose();
@@ -50,9 +51,20 @@ bool ekf_update(FilterState& s, const std::vector<const Measurement*>& ms) {
   r = 0;
   for (const auto* m : ms) {
     for (const auto& b : m->blocks)
-      S.middleRows(r, m->dim()).noalias() += b.H * PHt.middleRows(b.col, b.H.cols()).transpose();
+      S.middleRows(r, m->dim()).noalias() += b.H * PHt.middleRows(b.col, b.H.cols());
     S.block(r, r, m->dim(), m->dim()) += m->R;
     r += m->dim();
+  }
+  // Shared gimbal noise: every pair of projections of one camera is correlated through it.
+  std::vector<int> offsets;
+  r = 0;
+  for (const auto* m : ms) offsets.push_back(r), r += m->dim();
+  for (size_t a = 0; a < ms.size(); ++a) {
+    if (ms[a]->camera < 0) continue;
+    for (size_t b = 0; b < ms.size(); ++b)
+      if (ms[b]->camera == ms[a]->camera)
+        S.block(offsets[a], offsets[b], ms[a]->dim(), ms[b]->dim()).noalias() +=
+            ms[a]->orientation_sigma * ms[a]->orientation_sigma * ms[a]->V * ms[b]->V.transpose();
   }
   S = 0.5 * (S + S.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(S);

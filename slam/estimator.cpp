@@ -50,8 +50,14 @@ std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
   return out;
 }
 
-VisualUpdateResult Estimator::update_landmarks(const std::vector<Correspondence>& candidates) {
-  VisualUpdateResult r = update_with_correspondences(s_, cams_, candidates, cfg_.visual, rng_);
+VisualUpdateResult Estimator::update_visual(
+    const std::vector<Correspondence>& candidates,
+    const std::vector<std::pair<int, Eigen::Vector2d>>& lead_pixels) {
+  std::vector<Measurement> lead;
+  for (const auto& [cam, uv] : lead_pixels)
+    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.pixel_sigma))
+      lead.push_back(std::move(*m));
+  VisualUpdateResult r = update_with_correspondences(s_, cams_, candidates, cfg_.visual, rng_, lead);
   for (size_t i = 0; i < candidates.size(); ++i)
     if (r.accepted[i]) tracks_[candidates[i].id].matched = true;
   return r;
@@ -60,9 +66,6 @@ VisualUpdateResult Estimator::update_landmarks(const std::vector<Correspondence>
 SensorUpdateResult Estimator::update_sensors(const SensorBatch& b) {
   std::vector<Measurement> ms;
   if (b.gps) ms.push_back(gps_measurement(s_, *b.gps, cfg_.gps_sigma));
-  for (const auto& [cam, uv] : b.lead_pixels)
-    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.pixel_sigma))
-      ms.push_back(std::move(*m));
   for (const auto& [cam, z] : b.altimeter)
     ms.push_back(altimeter_measurement(s_, cam, cams_[cam], z, cfg_.altimeter_sigma));
   for (const auto& [cam, z] : b.range)

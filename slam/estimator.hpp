@@ -1,5 +1,5 @@
 // The estimator's face to a frontend (synthetic now, image-based later). Per step:
-//   predict(dt) -> landmarks_in_view(cam) for every camera -> update_landmarks(correspondences)
+//   predict(dt) -> landmarks_in_view(cam) for every camera -> update_visual(correspondences, lead)
 //   -> update_sensors(...) -> initialise_* for new points -> end_step() (map management).
 // It owns the filter state and composes the small pieces of slam/: motion model, measurement
 // models, gated and 1-point RANSAC updates, landmark initialisation. It never sees an image.
@@ -55,7 +55,6 @@ struct CrossMatch {
 // Non-landmark measurements of one instant; cameras by index.
 struct SensorBatch {
   std::optional<Eigen::Vector3d> gps;
-  std::vector<std::pair<int, Eigen::Vector2d>> lead_pixels;
   std::vector<std::pair<int, double>> altimeter;
   std::vector<std::pair<int, double>> range;
 };
@@ -78,7 +77,10 @@ class Estimator {
   // Landmarks predicted inside camera `cam`'s image (with the margin); records them as expected
   // to be matched this step, for map management.
   std::vector<LandmarkPrediction> landmarks_in_view(int cam);
-  VisualUpdateResult update_landmarks(const std::vector<Correspondence>& candidates);
+  // Landmark correspondences (1-point RANSAC and gating) together with the lead's projections
+  // (eq. 5-6) of the same frames, which share the gimbal noise with them.
+  VisualUpdateResult update_visual(const std::vector<Correspondence>& candidates,
+                                   const std::vector<std::pair<int, Eigen::Vector2d>>& lead_pixels = {});
   SensorUpdateResult update_sensors(const SensorBatch& batch);
   // Cooperative initialisation of each match (eq. 47-52); one outcome per match.
   std::vector<InitOutcome> initialise_from_matches(const std::vector<CrossMatch>& matches);

@@ -92,9 +92,12 @@ InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& r
   const Eigen::Matrix3d Ja = t->J.block<3, 3>(0, 0), Jb = t->J.block<3, 3>(0, 3);
   const Eigen::Matrix<double, 3, 4> Jz = t->J.rightCols<4>();
   const Eigen::MatrixXd cross = Ja * s.P.middleRows(pa, 3) + Jb * s.P.middleRows(pb, 3);
+  const Eigen::Matrix2d Ra = pixel_covariance(rig_a, rig_a.R_CW * (t->point - x_a), cfg.sigma_px);
+  const Eigen::Matrix2d Rb = pixel_covariance(rig_b, rig_b.R_CW * (t->point - x_b), cfg.sigma_px);
   const Eigen::Matrix3d cov = cross.middleCols(pa, 3) * Ja.transpose() +
                               cross.middleCols(pb, 3) * Jb.transpose() +
-                              cfg.sigma_px * cfg.sigma_px * Jz * Jz.transpose();
+                              Jz.leftCols<2>() * Ra * Jz.leftCols<2>().transpose() +
+                              Jz.rightCols<2>() * Rb * Jz.rightCols<2>().transpose();
   return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
 }
 
@@ -128,7 +131,9 @@ InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& r
   Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Zero();
   cov.topLeftCorner<3, 3>() = s.P.block<3, 3>(pc, pc);
   const Eigen::Matrix2d Juv = J.block<2, 2>(3, 3);
-  cov.block<2, 2>(3, 3) = cfg.sigma_px * cfg.sigma_px * Juv * Juv.transpose();
+  const Eigen::Vector2d xn = rig.model.unproject_normalised(uv);
+  const Eigen::Matrix2d Ruv = pixel_covariance(rig, Eigen::Vector3d(xn.x(), xn.y(), 1.0), cfg.sigma_px);
+  cov.block<2, 2>(3, 3) = Juv * Ruv * Juv.transpose();
   cov(5, 5) = cfg.sigma_rho * cfg.sigma_rho;
   return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
 }

@@ -56,7 +56,34 @@ double range_model(const Eigen::Vector3d& x_h, const Eigen::Vector3d& x_q,
   return r;
 }
 
+Eigen::Matrix<double, 2, 2> pixel_rotation_jacobian(const geometry::PinholeCamera& model,
+                                                    const Eigen::Vector3d& p_C) {
+  Eigen::Matrix<double, 2, 3> Jp;
+  model.project(p_C, &Jp);
+  // d((I + [w]x) p) / dw = -[p]x; keep the columns of rotations about x and y.
+  Eigen::Matrix<double, 3, 2> dp;
+  dp << 0, p_C.z(), -p_C.z(), 0, p_C.y(), -p_C.x();
+  return Jp * dp;
+}
+
+Eigen::Matrix2d pixel_covariance(const CameraRig& cam, const Eigen::Vector3d& p_C, double sigma_px) {
+  Eigen::Matrix2d R = sigma_px * sigma_px * Eigen::Matrix2d::Identity();
+  if (cam.orientation_sigma > 0) {
+    const Eigen::Matrix2d V = pixel_rotation_jacobian(cam.model, p_C);
+    R += cam.orientation_sigma * cam.orientation_sigma * V * V.transpose();
+  }
+  return R;
+}
+
 namespace {
+void attach_orientation_noise(Measurement& m, int cam_index, const CameraRig& cam,
+                              const Eigen::Vector3d& p_C) {
+  if (cam.orientation_sigma <= 0) return;
+  m.camera = cam_index;
+  m.orientation_sigma = cam.orientation_sigma;
+  m.V = pixel_rotation_jacobian(cam.model, p_C);
+}
+
 SmallSq isotropic(int dim, double sigma) {
   SmallSq R(dim, dim);
   R.setIdentity();
@@ -79,12 +106,17 @@ std::optional<Measurement> landmark_measurement(const FilterState& s, const Land
     if (!uv) return std::nullopt;
     m.h = *uv;
     m.blocks.push_back({lm.offset, J_xa});
+    attach_orientation_noise(m, cam_index, cam, cam.R_CW * (s.x.segment<3>(lm.offset) - x_c));
   } else {
     Eigen::Matrix<double, 2, 6> J_y;
-    auto uv = project_inverse_depth(cam, x_c, s.x.segment<6>(lm.offset), &J_xc, &J_y);
+    const Vector6d y = s.x.segment<6>(lm.offset);
+    auto uv = project_inverse_depth(cam, x_c, y, &J_xc, &J_y);
     if (!uv) return std::nullopt;
     m.h = *uv;
     m.blocks.push_back({lm.offset, J_y});
+    // The rotation Jacobian is scale invariant: the scaled point rho (x0 - x_c) + m will do.
+    attach_orientation_noise(m, cam_index, cam,
+                             cam.R_CW * (y(5) * (y.head<3>() - x_c) + inverse_depth_direction(y(3), y(4))));
   }
   m.blocks.push_back({FilterState::cam_pos(cam_index), J_xc});
   return m;
@@ -103,6 +135,9 @@ std::optional<Measurement> lead_projection_measurement(const FilterState& s, int
   m.R = isotropic(2, sigma_px);
   m.blocks.push_back({FilterState::lead_pos(), J_xh});
   m.blocks.push_back({FilterState::cam_pos(cam_index), J_xc});
+  attach_orientation_noise(m, cam_index, cam,
+                           cam.R_CW * (s.x.segment<3>(FilterState::lead_pos()) -
+                                       s.x.segment<3>(FilterState::cam_pos(cam_index))));
   return m;
 }
 

@@ -26,8 +26,14 @@ struct JacobianBlock {
 
 struct Measurement {
   SmallVec z, h;  // observed and predicted
-  SmallSq R;      // noise covariance the filter assumes
+  SmallSq R;      // independent noise covariance the filter assumes
   std::vector<JacobianBlock> blocks;
+  // Shared noise: the gimbal's pointing error about the camera's x and y axes is one rotation
+  // for every projection of that camera at that instant (the V R V^T of eq. 45, correlated across
+  // the camera's measurements). V = d h / d(rotation about x, y); camera -1 means none.
+  int camera = -1;
+  double orientation_sigma = 0;
+  Eigen::Matrix<double, Eigen::Dynamic, 2, 0, 3, 2> V;
   int dim() const { return static_cast<int>(z.size()); }
   SmallVec innovation() const { return z - h; }
 };
@@ -38,7 +44,17 @@ struct CameraRig {
   geometry::PinholeCamera model;
   Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();  // d of eq. 59: camera minus UAV position
+  // Std of the gimbal's pointing error about the camera's x and y axes (rad) that the filter
+  // assumes; 0 trusts R_CW exactly, as the paper's filter does.
+  double orientation_sigma = 0;
 };
+
+// d uv / d(small rotation of the camera about its x and y axes) at a point p_C in the camera
+// frame: p_C -> (I + [w]x) p_C.
+Eigen::Matrix<double, 2, 2> pixel_rotation_jacobian(const geometry::PinholeCamera& model,
+                                                    const Eigen::Vector3d& p_C);
+// The pixel covariance a projection at p_C carries: sigma_px^2 I + V Sigma_gimbal V^T.
+Eigen::Matrix2d pixel_covariance(const CameraRig& cam, const Eigen::Vector3d& p_C, double sigma_px);
 
 // eq. 3-4: projection of a Euclidean point; Jacobians w.r.t. camera and point positions.
 std::optional<Eigen::Vector2d> project_point(const CameraRig& cam, const Eigen::Vector3d& x_c,

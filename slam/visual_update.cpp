@@ -26,8 +26,19 @@ double gate_threshold(double probability, int dof) {
 VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector<CameraRig>& cams,
                                                const std::vector<Correspondence>& candidates,
                                                const VisualUpdateSettings& cfg,
-                                               std::mt19937_64& rng) {
+                                               std::mt19937_64& rng,
+                                               const std::vector<Measurement>& companions) {
   VisualUpdateResult res;
+  std::vector<bool>* companion_accepted = &res.companion_accepted;
+  std::vector<const Measurement*> extra;
+  if (companion_accepted) companion_accepted->assign(companions.size(), false);
+  for (size_t i = 0; i < companions.size(); ++i) {
+    const auto& m = companions[i];
+    if (mahalanobis_squared(m, innovation_covariance(s, m)) > gate_threshold(cfg.gate_probability, m.dim()))
+      continue;
+    extra.push_back(&m);
+    if (companion_accepted) (*companion_accepted)[i] = true;
+  }
   res.accepted.assign(candidates.size(), false);
   const double gate2 = gate_threshold(cfg.gate_probability, 2);
 
@@ -45,10 +56,14 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
     compatible.push_back(static_cast<int>(i));
   }
   res.compatible = static_cast<int>(compatible.size());
-  if (compatible.empty()) return res;
+  if (compatible.empty()) {
+    if (!extra.empty() && !ekf_update(s, extra) && companion_accepted)
+      companion_accepted->assign(companions.size(), false);
+    return res;
+  }
 
   if (!cfg.one_point_ransac) {
-    std::vector<const Measurement*> batch;
+    std::vector<const Measurement*> batch = extra;
     for (int i : compatible) batch.push_back(&meas[i]);
     if (ekf_update(s, batch))
       for (int i : compatible) res.accepted[i] = true;
@@ -79,11 +94,14 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
     }
   }
   res.low_innovation_inliers = static_cast<int>(best.size());
-  if (!best.empty()) {
-    std::vector<const Measurement*> batch;
+  {
+    std::vector<const Measurement*> batch = extra;
     for (int i : best) batch.push_back(&meas[i]);
-    if (ekf_update(s, batch))
+    if (ekf_update(s, batch)) {
       for (int i : best) res.accepted[i] = true;
+    } else if (companion_accepted) {
+      companion_accepted->assign(companions.size(), false);
+    }
   }
 
   // Rescue the high-innovation inliers with the corrected state and covariance.

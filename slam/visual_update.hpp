@@ -35,12 +35,16 @@ struct VisualUpdateResult {
   int hypotheses = 0;
   int low_innovation_inliers = 0;
   int rescued = 0;
+  std::vector<bool> companion_accepted;
 };
 
+// `companions` (e.g. lead projections of the same frames) are gated on their own and join the
+// first joint update, so the gimbal noise they share with the landmarks is modelled jointly.
 VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector<CameraRig>& cams,
                                                const std::vector<Correspondence>& candidates,
                                                const VisualUpdateSettings& settings,
-                                               std::mt19937_64& rng);
+                                               std::mt19937_64& rng,
+                                               const std::vector<Measurement>& companions = {});
 
 // Gated batch update with other measurements (lead projection, GPS, altimeter, range): each is
 // tested on its own against the chi^2 gate of its dimension; the compatible ones update jointly.

@@ -1,0 +1,281 @@
+#include "app/pipeline.hpp"
+
+#include <Eigen/Cholesky>
+#include <chrono>
+#include <map>
+#include <stdexcept>
+
+#include "app/version.hpp"
+#include "sim/synthetic_source.hpp"
+#include "sim/truth.hpp"
+#include "slam/estimator.hpp"
+
+namespace wingman::app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
+  const auto& e = scn.estimator;
+  slam::EstimatorSettings s;
+  s.accel_sigma_lead = e.accel_sigma_lead;
+  s.accel_sigma_uav = e.accel_sigma_uav;
+  s.pixel_sigma = e.pixel_sigma;
+  s.gps_sigma = e.gps_sigma;
+  s.altimeter_sigma = e.altimeter_sigma;
+  s.range_sigma = e.range_sigma;
+  s.initial_position_sigma = e.initial_position_sigma;
+  s.initial_velocity_sigma = e.initial_velocity_sigma;
+  s.gate_probability = e.gate_probability;
+  s.visual.one_point_ransac = e.one_point_ransac;
+  s.visual.inlier_px = e.ransac_inlier_px;
+  s.visual.success_probability = e.ransac_success_probability;
+  s.visual.max_hypotheses = e.ransac_max_hypotheses;
+  s.cooperative.min_parallax_deg = e.min_parallax_deg;
+  s.cooperative.max_reprojection_px = e.max_reprojection_px;
+  s.inverse_depth.rho = e.inverse_depth_rho;
+  s.inverse_depth.sigma_rho = e.inverse_depth_sigma;
+  s.linearity_threshold = e.linearity_threshold;
+  s.max_landmarks = e.max_landmarks;
+  s.max_misses = e.max_misses;
+  s.image_margin_px = e.image_margin_px;
+  s.seed = scn.seed;
+  return s;
+}
+
+// NEES (eq. 67) over the agents' positions and velocities.
+double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
+  const int d = s.agent_dim();
+  const Eigen::VectorXd e = truth - s.x.head(d);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(s.P.topLeftCorner(d, d));
+  if (ldlt.info() != Eigen::Success) return eval::kNaN;
+  return e.dot(ldlt.solve(e));
+}
+
+}  // namespace
+
+eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress) {
+  const auto wall0 = Clock::now();
+  const bool single = scn.estimator.mode == sim::EstimatorMode::SingleUav;
+  const sim::OpenLoopTruth truth(scn);
+  sim::SyntheticSource source(scn, truth);
+
+  // Cameras in the filter, by UAV index: every UAV (multi) or only the baseline's (single).
+  std::vector<int> cam_uav;
+  if (single) {
+    cam_uav.push_back(scn.uav_index(scn.estimator.single_uav));
+  } else {
+    for (int j = 0; j < static_cast<int>(scn.uavs.size()); ++j) cam_uav.push_back(j);
+  }
+  const int ncam = static_cast<int>(cam_uav.size());
+
+  std::vector<slam::CameraRig> rigs;
+  std::vector<slam::AgentInit> cam_init;
+  for (int u : cam_uav) {
+    slam::CameraRig rig;
+    rig.model = scn.uavs[u].camera.camera();
+    rig.R_CW = truth.commanded_R_CW();
+    rig.offset = scn.uavs[u].camera.offset;
+    rig.orientation_sigma = scn.estimator.orientation_sigma;
+    rigs.push_back(rig);
+    const auto c = truth.camera(u, 0.0);
+    cam_init.push_back({c.position, c.velocity});
+  }
+  const auto lead0 = truth.lead(0.0);
+  slam::Estimator est(rigs, {lead0.position, lead0.velocity}, cam_init, estimator_settings(scn));
+
+  eval::RunRecord rec;
+  rec.scenario_path = scn.source_path;
+  rec.scenario_name = scn.name;
+  rec.variant = scn.variant;
+  rec.estimator_mode = sim::to_string(scn.estimator.mode);
+  rec.seed = scn.seed;
+  rec.software_version = kVersion;
+  rec.agent_names.push_back("lead");
+  for (int u : cam_uav) rec.agent_names.push_back(scn.uavs[u].name);
+  for (const auto& p : scn.phases)
+    rec.phases.push_back({p.name, p.t_start, p.t_end, sim::to_string(p.config)});
+  for (int u : cam_uav) rec.outliers.push_back({scn.uavs[u].name});
+  if (!single) rec.outliers.push_back({"cooperative"});
+  eval::OutlierCounts* coop = single ? nullptr : &rec.outliers.back();
+
+  std::map<slam::LandmarkId, std::size_t> lm_record;  // filter id -> index in rec.landmarks
+  const int target = scn.estimator.target_landmarks_per_camera;
+
+  auto record_step = [&](int k, double t, int visible, int offered, int accepted, int initialised,
+                         double tp, double tu, double ti) {
+    eval::StepRecord st;
+    st.k = k;
+    st.t = t;
+    st.phase = scn.phase_at(t);
+    const auto& s = est.state();
+    Eigen::VectorXd x_true(s.agent_dim());
+    auto agent = [&](const sim::KinematicState& tr, int pos) {
+      eval::AgentStep a;
+      a.p_true = tr.position;
+      a.v_true = tr.velocity;
+      a.p_est = s.x.segment<3>(pos);
+      a.v_est = s.x.segment<3>(pos + 3);
+      a.p_sigma = s.P.block<3, 3>(pos, pos).diagonal().cwiseMax(0.0).cwiseSqrt();
+      x_true.segment<3>(pos) = tr.position;
+      x_true.segment<3>(pos + 3) = tr.velocity;
+      st.agents.push_back(a);
+    };
+    agent(truth.lead(t), slam::FilterState::lead_pos());
+    for (int j = 0; j < ncam; ++j) agent(truth.camera(cam_uav[j], t), slam::FilterState::cam_pos(j));
+    st.nees = k == 0 ? eval::kNaN : agent_nees(s, x_true);
+    st.nees_dof = s.agent_dim();
+    st.landmarks = est.num_landmarks();
+    st.landmarks_visible = visible;
+    st.matches_offered = offered;
+    st.matches_accepted = accepted;
+    st.initialised = initialised;
+    st.t_predict_ms = tp;
+    st.t_update_ms = tu;
+    st.t_init_ms = ti;
+    rec.steps.push_back(std::move(st));
+  };
+  // Latest estimate of every landmark in the map; a landmark removed later keeps its last one.
+  auto snapshot_landmarks = [&](int phase) {
+    for (const auto& slot : est.state().landmarks()) {
+      auto it = lm_record.find(slot.id);
+      if (it == lm_record.end()) continue;
+      auto& lr = rec.landmarks[it->second];
+      lr.est_final = est.state().landmark_position(slot);
+      if (phase == lr.init_phase) lr.est_phase_end = lr.est_final;
+    }
+  };
+
+  record_step(0, 0.0, 0, 0, 0, 0, 0, 0, 0);
+  const int N = scn.num_steps();
+  const double dt = scn.dt();
+  for (int k = 1; k <= N; ++k) {
+    const double t = k * dt;
+    const int phase = scn.phase_at(t);
+
+    auto t0 = Clock::now();
+    est.predict(dt);
+    const double t_predict = ms_since(t0);
+
+    // Landmark correspondences for what the filter predicts in view, by identity.
+    t0 = Clock::now();
+    std::vector<slam::Correspondence> cands;
+    std::vector<sim::PixelObservation> obs_all;
+    std::vector<int> cand_channel;
+    std::vector<int> in_view(ncam, 0);
+    std::vector<bool> sees_landmarks(ncam, false);
+    int visible = 0;
+    for (int j = 0; j < ncam; ++j) {
+      const auto& name = scn.uavs[cam_uav[j]].name;
+      if (!scn.sensor_active(sim::Sensor::Landmarks, t, name)) continue;
+      sees_landmarks[j] = true;
+      est.set_camera_rotation(j, truth.commanded_R_CW());
+      const auto preds = est.landmarks_in_view(j);
+      in_view[j] = static_cast<int>(preds.size());
+      visible += in_view[j];
+      std::vector<std::int64_t> ids;
+      for (const auto& p : preds) ids.push_back(p.id);
+      for (const auto& o : source.observe_landmarks(cam_uav[j], t, ids)) {
+        cands.push_back({j, o.landmark, o.uv});
+        obs_all.push_back(o);
+        cand_channel.push_back(j);
+      }
+    }
+    std::vector<std::pair<int, Eigen::Vector2d>> lead_pixels;
+    for (int j = 0; j < ncam; ++j)
+      if (scn.sensor_active(sim::Sensor::LeadProjection, t, scn.uavs[cam_uav[j]].name))
+        if (auto uv = source.lead_pixel(cam_uav[j], t)) lead_pixels.emplace_back(j, *uv);
+    const auto vr = est.update_visual(cands, lead_pixels);
+    int accepted = 0;
+    for (size_t i = 0; i < cands.size(); ++i) {
+      auto& oc = rec.outliers[cand_channel[i]];
+      ++oc.correspondences;
+      // Synthetic mode: an outlier is a correspondence the source corrupted (DESIGN.md §3).
+      if (obs_all[i].injected_outlier) ++oc.injected, ++oc.outliers;
+      if (vr.accepted[i]) {
+        ++accepted;
+        ++oc.accepted;
+        if (obs_all[i].injected_outlier) ++oc.outliers_accepted;
+      }
+    }
+
+    slam::SensorBatch batch;
+    if (scn.sensor_active(sim::Sensor::Gps, t, "lead")) batch.gps = source.gps(t);
+    for (int j = 0; j < ncam; ++j) {
+      const int u = cam_uav[j];
+      const auto& name = scn.uavs[u].name;
+      if (scn.sensor_active(sim::Sensor::Altimeter, t, name))
+        batch.altimeter.emplace_back(j, source.altimeter(u, t));
+      if (scn.sensor_active(sim::Sensor::Range, t, name)) batch.range.emplace_back(j, source.range(u, t));
+    }
+    est.update_sensors(batch);
+    const double t_update = ms_since(t0);
+    snapshot_landmarks(phase);
+
+    // New landmarks where a camera sees fewer than the target.
+    t0 = Clock::now();
+    int initialised = 0;
+    auto add_record = [&](slam::LandmarkId id, std::size_t point, const char* origin) {
+      source.bind(id, point);
+      eval::LandmarkRecord lr;
+      lr.id = id;
+      lr.truth = source.field()[point];
+      lr.t_init = t;
+      lr.init_phase = phase;
+      lr.est_init = lr.est_phase_end = lr.est_final = *est.landmark_position(id);
+      lr.origin = origin;
+      lm_record[id] = rec.landmarks.size();
+      rec.landmarks.push_back(lr);
+      ++initialised;
+    };
+    if (single) {
+      const int need = target - in_view[0];
+      if (sees_landmarks[0] && need > 0)
+        for (const auto& o : source.new_points(cam_uav[0], t, need)) {
+          auto r = est.initialise_from_pixel(0, o.uv);
+          if (r.id) add_record(*r.id, o.point, "inverse_depth");
+        }
+    } else {
+      // Pair each camera with the next; a pair asks for the larger deficit of its two cameras.
+      std::map<std::pair<int, int>, int> pairs;
+      for (int j = 0; j < ncam; ++j) {
+        const int o = (j + 1) % ncam;
+        const int need = target - in_view[j];
+        if (o == j || need <= 0 || !sees_landmarks[j] || !sees_landmarks[o]) continue;
+        auto key = std::minmax(j, o);
+        pairs[key] = std::max(pairs[key], need);
+      }
+      for (const auto& [pr, need] : pairs) {
+        const auto matches = source.cross_matches(cam_uav[pr.first], cam_uav[pr.second], t, need);
+        std::vector<slam::CrossMatch> cm;
+        for (const auto& m : matches) cm.push_back({pr.first, pr.second, m.uv_a, m.uv_b});
+        const auto outcomes = est.initialise_from_matches(cm);
+        for (size_t i = 0; i < matches.size(); ++i) {
+          ++coop->correspondences;
+          if (matches[i].injected_outlier) ++coop->injected, ++coop->outliers;
+          if (!outcomes[i].id) continue;
+          ++coop->accepted;
+          if (matches[i].injected_outlier) ++coop->outliers_accepted;
+          add_record(*outcomes[i].id, matches[i].point, "cooperative");
+        }
+      }
+    }
+    for (slam::LandmarkId id : est.end_step()) {
+      source.unbind(id);
+      if (auto it = lm_record.find(id); it != lm_record.end()) rec.landmarks[it->second].t_removed = t;
+    }
+    const double t_init = ms_since(t0);
+
+    record_step(k, t, visible, static_cast<int>(cands.size()), accepted, initialised, t_predict,
+                t_update, t_init);
+    if (progress) progress(k, N);
+  }
+  rec.wall_time_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  return rec;
+}
+
+}  // namespace wingman::app

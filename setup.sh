@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Wingman's one entry point for a fresh Debian 12 machine:
+#   bash setup.sh run    install packages, build, run the default scenario (scenes/paper_synthetic.yaml)
+#   bash setup.sh test   install packages, build, run every test (what CI runs)
+#   bash setup.sh build  install packages and build only
+# Environment: BUILD_DIR (default build), JOBS (default: all cores), WINGMAN_SKIP_APT=1 to skip apt.
+set -euo pipefail
+
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+cd "$here"
+mode=${1:-build}
+build_dir=${BUILD_DIR:-build}
+jobs=${JOBS:-$(nproc)}
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libeigen3-dev libyaml-cpp-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libcli11-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  gnuplot-nox
+)
+
+install_packages() {
+  [ "${WINGMAN_SKIP_APT:-0}" = 1 ] && return 0
+  local missing=()
+  for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "setup: installing ${missing[*]}"
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo=sudo
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+build() {
+  cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build "$build_dir" -j "$jobs"
+}
+
+case "$mode" in
+  build)
+    install_packages
+    build
+    ;;
+  run)
+    install_packages
+    build
+    shift || true
+    "$build_dir/app/wingman" run scenes/paper_synthetic.yaml --out results/paper_synthetic "$@"
+    ;;
+  test)
+    install_packages
+    build
+    cd "$build_dir"
+    ctest --output-on-failure -j "$jobs"
+    ;;
+  *)
+    echo "usage: bash setup.sh [build|run|test]" >&2
+    exit 2
+    ;;
+esac

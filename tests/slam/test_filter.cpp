@@ -1,0 +1,227 @@
+// The filter's pieces against their textbook dense forms and known answers.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+#include "geometry/rotation.hpp"
+#include "slam/ekf_update.hpp"
+#include "slam/estimator.hpp"
+#include "slam/inverse_depth.hpp"
+#include "slam/landmark_init.hpp"
+#include "slam/motion_model.hpp"
+
+using namespace wingman;
+using namespace wingman::slam;
+
+namespace {
+Eigen::MatrixXd random_spd(int n, std::mt19937_64& rng) {
+  std::normal_distribution<double> g;
+  Eigen::MatrixXd A(n, n);
+  for (int i = 0; i < A.size(); ++i) A.data()[i] = g(rng);
+  return A * A.transpose() / n + 0.1 * Eigen::MatrixXd::Identity(n, n);
+}
+CameraRig nadir_rig() {
+  CameraRig r;
+  r.R_CW = geometry::nadir_R_CW();
+  return r;
+}
+FilterState two_camera_state_with_landmarks(int n_landmarks, std::mt19937_64& rng) {
+  FilterState s(2);
+  s.x << 0, 0, 0, 1, 0, 0, -1.5, 0, 15, 1, 0, 0, 1.5, 0, 17, 1, 0, 0;
+  std::uniform_real_distribution<double> u(-20, 20);
+  for (int i = 0; i < n_landmarks; ++i)
+    s.add_landmark(LandmarkKind::Euclidean, Eigen::Vector3d(u(rng), u(rng), 0.1 * u(rng)),
+                   Eigen::MatrixXd::Zero(3, s.dim()), Eigen::Matrix3d::Zero());
+  s.P = random_spd(s.dim(), rng) * 0.01;
+  return s;
+}
+}  // namespace
+
+TEST(Prediction, EqualsDenseAPAtPlusQ) {
+  std::mt19937_64 rng(3);
+  FilterState s = two_camera_state_with_landmarks(4, rng);
+  const FilterState before = s;
+  const double dt = 0.1, sl = 0.2, su = 0.3;
+  predict_constant_velocity(s, dt, sl, su);
+  const int n = s.dim();
+  Eigen::MatrixXd A = Eigen::MatrixXd::Identity(n, n), Q = Eigen::MatrixXd::Zero(n, n);
+  for (int a = 0; a < 3; ++a) {
+    const int p = 6 * a;
+    A.block<3, 3>(p, p + 3) = dt * Eigen::Matrix3d::Identity();
+    Q.block<3, 3>(p + 3, p + 3) = std::pow((a == 0 ? sl : su) * dt, 2) * Eigen::Matrix3d::Identity();
+  }
+  EXPECT_LT((s.x - A * before.x).norm(), 1e-12);
+  EXPECT_LT((s.P - (A * before.P * A.transpose() + Q)).norm(), 1e-12);
+}
+
+TEST(Update, SparseUpdateEqualsDenseKalmanUpdate) {
+  std::mt19937_64 rng(5);
+  FilterState s = two_camera_state_with_landmarks(6, rng);
+  const FilterState before = s;
+  const CameraRig rig = nadir_rig();
+  std::vector<Measurement> ms;
+  for (int i = 0; i < 4; ++i) {
+    auto uv = predict_landmark_pixel(s.x, s.landmarks()[i], i % 2, rig);
+    ASSERT_TRUE(uv);
+    ms.push_back(*landmark_measurement(s, s.landmarks()[i], i % 2, rig, *uv + Eigen::Vector2d(2, -1), 3));
+  }
+  ms.push_back(gps_measurement(s, Eigen::Vector3d(0.5, -0.3, 0.2), 1.5));
+  ms.push_back(range_measurement(s, 0, rig, 15.5, 0.5));
+  std::vector<const Measurement*> ptrs;
+  for (const auto& m : ms) ptrs.push_back(&m);
+  ASSERT_TRUE(ekf_update(s, ptrs));
+
+  // Dense reference: eq. 43-45.
+  int rows = 0;
+  for (const auto& m : ms) rows += m.dim();
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(rows, before.dim()), R = Eigen::MatrixXd::Zero(rows, rows);
+  Eigen::VectorXd y(rows);
+  int r = 0;
+  for (const auto& m : ms) {
+    for (const auto& b : m.blocks) H.block(r, b.col, m.dim(), b.H.cols()) += b.H;
+    R.block(r, r, m.dim(), m.dim()) = m.R;
+    y.segment(r, m.dim()) = m.innovation();
+    r += m.dim();
+  }
+  const Eigen::MatrixXd S = H * before.P * H.transpose() + R;
+  const Eigen::MatrixXd K = before.P * H.transpose() * S.inverse();
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(before.dim(), before.dim());
+  EXPECT_LT((s.x - (before.x + K * y)).norm(), 1e-9);
+  EXPECT_LT((s.P - (I - K * H) * before.P).norm(), 1e-9);
+  EXPECT_EQ((s.P - s.P.transpose()).norm(), 0.0);
+}
+
+TEST(Triangulation, RecoversAKnownPoint) {
+  const CameraRig rig = nadir_rig();
+  const Eigen::Vector3d xa(-1.5, 0, 15), xb(1.5, 0, 17), p(7.3, -12.1, 0.8);
+  auto t = triangulate_two_views(rig, xa, *project_point(rig, xa, p), rig, xb, *project_point(rig, xb, p));
+  ASSERT_TRUE(t);
+  EXPECT_LT((t->point - p).norm(), 1e-9);
+  EXPECT_LT(t->reprojection_px, 1e-9);
+  EXPECT_NEAR(t->parallax_rad, std::acos((xa - p).normalized().dot((xb - p).normalized())), 1e-12);
+}
+
+TEST(InverseDepth, ConversionToXyzIsExactForANoiselessPoint) {
+  const CameraRig rig = nadir_rig();
+  const Eigen::Vector3d x_c(2, -1, 15), p(9.5, 4.2, 0.6);
+  const Eigen::Vector2d uv = *project_point(rig, x_c, p);
+  const double depth = (p - x_c).norm();
+  const Vector6d y = inverse_depth_from_pixel(rig, x_c, uv, 1.0 / depth);
+  EXPECT_LT((inverse_depth_to_point(y) - p).norm(), 1e-10);
+
+  // In the state: the converted landmark has the same position and covariance J P J^T.
+  FilterState s(1);
+  s.P.setIdentity();
+  Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Identity() * 1e-4;
+  C(5, 5) = 1e-6;
+  const LandmarkId id = s.add_landmark(LandmarkKind::InverseDepth, y, Eigen::MatrixXd::Zero(6, 12), C);
+  Eigen::Matrix<double, 3, 6> J;
+  const Eigen::Vector3d q = inverse_depth_to_point(y, &J);
+  s.convert_to_euclidean(id, q, J);
+  EXPECT_EQ(s.dim(), 15);
+  EXPECT_LT((s.x.tail<3>() - p).norm(), 1e-10);
+  EXPECT_LT((s.P.bottomRightCorner<3, 3>() - J * C * J.transpose()).norm(), 1e-15);
+}
+
+TEST(InverseDepth, LinearityIndexFallsWithParallax) {
+  const Eigen::Vector3d x0(0, 0, 15), p(0, 0, 0);
+  Vector6d y;
+  y << x0, 0, 0, 1.0 / 15;
+  // Seen again from the anchor: no parallax, L large; from 10 m away, much smaller.
+  EXPECT_GT(linearity_index(y, 0.02, x0), linearity_index(y, 0.02, Eigen::Vector3d(10, 0, 15)));
+}
+
+TEST(Landmarks, RemoveKeepsTheOtherBlocks) {
+  std::mt19937_64 rng(9);
+  FilterState s = two_camera_state_with_landmarks(3, rng);
+  const FilterState before = s;
+  s.remove_landmark(s.landmarks()[1].id);
+  ASSERT_EQ(s.dim(), before.dim() - 3);
+  EXPECT_EQ(s.landmarks()[1].offset, 21);
+  EXPECT_LT((s.P.topLeftCorner(21, 21) - before.P.topLeftCorner(21, 21)).norm(), 1e-15);
+  EXPECT_LT((s.P.block<3, 3>(21, 21) - before.P.block<3, 3>(24, 24)).norm(), 1e-15);
+  EXPECT_LT((s.P.block<3, 21>(21, 0) - before.P.block<3, 21>(24, 0)).norm(), 1e-15);
+}
+
+namespace {
+// Two UAVs over a grid of landmarks initialised cooperatively from exact pixels.
+struct Scene {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<LandmarkId> ids;
+  Estimator est;
+  Scene(bool ransac)
+      : est({nadir_rig(), nadir_rig()}, {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()},
+            {{Eigen::Vector3d(-1.5, 0, 15), Eigen::Vector3d::Zero()},
+             {Eigen::Vector3d(1.5, 0, 17), Eigen::Vector3d::Zero()}},
+            settings(ransac)) {
+    const CameraRig rig = nadir_rig();
+    for (int i = -2; i <= 2; ++i)
+      for (int j = -2; j <= 2; ++j) {
+        const Eigen::Vector3d p(6.0 * i, 6.0 * j, 0.3 * ((i + j) % 2));
+        auto o = est.initialise_from_matches({{0, 1, *project_point(rig, est.camera_position(0), p),
+                                               *project_point(rig, est.camera_position(1), p)}});
+        points.push_back(p);
+        ids.push_back(*o[0].id);
+      }
+  }
+  static EstimatorSettings settings(bool ransac) {
+    EstimatorSettings s;
+    s.visual.one_point_ransac = ransac;
+    s.initial_position_sigma = 0.3;
+    return s;
+  }
+};
+}  // namespace
+
+class OutlierTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(OutlierTest, AFarOutlierIsRejectedAndInliersAccepted) {
+  Scene sc(GetParam());
+  ASSERT_EQ(sc.est.num_landmarks(), 25);
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> noise(0, 1.0);
+  std::vector<Correspondence> cands;
+  const CameraRig rig = nadir_rig();
+  for (size_t i = 0; i < sc.points.size(); ++i) {
+    Eigen::Vector2d uv = *project_point(rig, sc.est.camera_position(0), sc.points[i]);
+    uv += Eigen::Vector2d(noise(rng), noise(rng));
+    if (i == 7) uv += Eigen::Vector2d(60, -45);  // a mismatch 75 px away
+    cands.push_back({0, sc.ids[i], uv});
+  }
+  const auto r = sc.est.update_visual(cands);
+  EXPECT_FALSE(r.accepted[7]);
+  int accepted = 0;
+  for (bool a : r.accepted) accepted += a;
+  EXPECT_EQ(accepted, 24);
+}
+
+INSTANTIATE_TEST_SUITE_P(GateAndRansac, OutlierTest, ::testing::Bool());
+
+TEST(Estimator, CooperativeInitialisationCarriesCrossCovariance) {
+  Scene sc(true);
+  const auto& s = sc.est.state();
+  const auto* lm = s.find(sc.ids[0]);
+  // Correlated with both cameras (eq. 52), and its own covariance positive definite.
+  const double c0 = s.P.block(lm->offset, FilterState::cam_pos(0), 3, 3).norm();
+  const double c1 = s.P.block(lm->offset, FilterState::cam_pos(1), 3, 3).norm();
+  EXPECT_GT(c0, 1e-3);
+  EXPECT_GT(c1, 1e-3);
+  Eigen::LLT<Eigen::MatrixXd> llt(s.P);
+  EXPECT_EQ(llt.info(), Eigen::Success);
+}
+
+TEST(Estimator, MapCapEvictsLandmarksOutOfView) {
+  EstimatorSettings cfg = Scene::settings(true);
+  cfg.max_landmarks = 5;
+  Estimator est({nadir_rig(), nadir_rig()}, {}, {{Eigen::Vector3d(-1.5, 0, 15), Eigen::Vector3d::Zero()}, {Eigen::Vector3d(1.5, 0, 17), Eigen::Vector3d::Zero()}}, cfg);
+  const CameraRig rig = nadir_rig();
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d p(3.0 * i - 10, 2.0, 0);
+    est.initialise_from_matches({{0, 1, *project_point(rig, est.camera_position(0), p),
+                                  *project_point(rig, est.camera_position(1), p)}});
+  }
+  // No camera expected any landmark this step, so the oldest were evicted to keep the cap.
+  EXPECT_EQ(est.num_landmarks(), 5);
+  EXPECT_EQ(est.end_step().size(), 3u);
+}

@@ -1,0 +1,159 @@
+// Every analytic Jacobian of slam/ against central differences.
+#include <gtest/gtest.h>
+
+#include "../numdiff.hpp"
+#include "geometry/rotation.hpp"
+#include "slam/inverse_depth.hpp"
+#include "slam/landmark_init.hpp"
+#include "slam/measurement_models.hpp"
+
+using namespace wingman;
+using namespace wingman::slam;
+using wingman::testing::numerical_jacobian;
+
+namespace {
+CameraRig tilted_rig(bool distorted) {
+  CameraRig r;
+  r.model = distorted ? geometry::PinholeCamera(200.1, 200.1, 500, 500, 1000, 1000,
+                                                {-0.1, 0.02, 0.001, -0.001, 0})
+                      : geometry::PinholeCamera();
+  r.R_CW = geometry::gimbal_error(0.03) * geometry::nadir_R_CW();
+  return r;
+}
+constexpr double kTol = 1e-5;
+}  // namespace
+
+class JacobianTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(JacobianTest, LandmarkProjectionEq3And4) {
+  const CameraRig rig = tilted_rig(GetParam());
+  const Eigen::Vector3d x_c(1, 2, 15), x_a(4, -3, 0.5);
+  Eigen::Matrix<double, 2, 3> J_xc, J_xa;
+  ASSERT_TRUE(project_point(rig, x_c, x_a, &J_xc, &J_xa));
+  auto f_c = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return *project_point(rig, v, x_a); };
+  auto f_a = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return *project_point(rig, x_c, v); };
+  EXPECT_LT((J_xc - numerical_jacobian(f_c, x_c)).norm(), kTol);
+  EXPECT_LT((J_xa - numerical_jacobian(f_a, x_a)).norm(), kTol);
+}
+
+TEST_P(JacobianTest, InverseDepthProjection) {
+  const CameraRig rig = tilted_rig(GetParam());
+  const Eigen::Vector3d x_c(1, 2, 15);
+  Vector6d y;
+  y << 0.5, 1.5, 14.0, 0.2, -0.15, 0.07;
+  Eigen::Matrix<double, 2, 3> J_xc;
+  Eigen::Matrix<double, 2, 6> J_y;
+  ASSERT_TRUE(project_inverse_depth(rig, x_c, y, &J_xc, &J_y));
+  auto f_c = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return *project_inverse_depth(rig, v, y); };
+  auto f_y = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+    return *project_inverse_depth(rig, x_c, Vector6d(v));
+  };
+  EXPECT_LT((J_xc - numerical_jacobian(f_c, x_c)).norm(), kTol);
+  EXPECT_LT((J_y - numerical_jacobian(f_y, y)).norm(), kTol);
+}
+
+TEST_P(JacobianTest, TriangulationEq52) {
+  const CameraRig rig = tilted_rig(GetParam());
+  const Eigen::Vector3d xa(-1.5, 0, 15), xb(1.5, 0.3, 17), p(3, -4, 0.7);
+  const Eigen::Vector2d ua = *project_point(rig, xa, p) + Eigen::Vector2d(1.2, -0.7);
+  const Eigen::Vector2d ub = *project_point(rig, xb, p) + Eigen::Vector2d(-0.4, 2.1);
+  auto t = triangulate_two_views(rig, xa, ua, rig, xb, ub);
+  ASSERT_TRUE(t);
+  Eigen::VectorXd params(10);
+  params << xa, xb, ua, ub;
+  auto f = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+    return triangulate_two_views(rig, v.segment<3>(0), v.segment<2>(6), rig, v.segment<3>(3),
+                                 v.segment<2>(8))
+        ->point;
+  };
+  EXPECT_LT((t->J - numerical_jacobian(f, params)).norm(), 1e-5 * t->J.norm());
+}
+
+TEST_P(JacobianTest, InverseDepthFromPixel) {
+  const CameraRig rig = tilted_rig(GetParam());
+  const Eigen::Vector3d x_c(1, 2, 15);
+  const Eigen::Vector2d uv(620, 310);
+  Eigen::Matrix<double, 6, 5> J;
+  inverse_depth_from_pixel(rig, x_c, uv, 0.05, &J);
+  Eigen::VectorXd params(5);
+  params << x_c, uv;
+  auto f = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+    return inverse_depth_from_pixel(rig, v.head<3>(), v.tail<2>(), 0.05);
+  };
+  EXPECT_LT((J - numerical_jacobian(f, params)).norm(), kTol);
+}
+
+INSTANTIATE_TEST_SUITE_P(WithAndWithoutDistortion, JacobianTest, ::testing::Bool());
+
+TEST(Jacobians, InverseDepthToPointAndAngles) {
+  Vector6d y;
+  y << 0.5, 1.5, 14.0, 0.3, -0.2, 0.08;
+  Eigen::Matrix<double, 3, 6> J;
+  inverse_depth_to_point(y, &J);
+  auto f = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return inverse_depth_to_point(Vector6d(v)); };
+  EXPECT_LT((J - numerical_jacobian(f, y)).norm(), kTol);
+
+  const Eigen::Vector3d ray(0.3, -0.2, -1.0);
+  Eigen::Matrix<double, 2, 3> Ja;
+  inverse_depth_angles(ray, &Ja);
+  auto g = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd { return inverse_depth_angles(v); };
+  EXPECT_LT((Ja - numerical_jacobian(g, ray)).norm(), kTol);
+  // The angles give back the ray's direction.
+  const Eigen::Vector2d a = inverse_depth_angles(ray);
+  EXPECT_LT((inverse_depth_direction(a(0), a(1)) - ray.normalized()).norm(), 1e-12);
+}
+
+TEST(Jacobians, RangeEq9) {
+  const Eigen::Vector3d xh(1, 2, 0.5), xq(-0.5, 2.5, 15);
+  Eigen::Matrix<double, 1, 3> Jh, Jq;
+  range_model(xh, xq, &Jh, &Jq);
+  auto fh = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+    return Eigen::VectorXd::Constant(1, range_model(v, xq));
+  };
+  auto fq = [&](const Eigen::VectorXd& v) -> Eigen::VectorXd {
+    return Eigen::VectorXd::Constant(1, range_model(xh, v));
+  };
+  EXPECT_LT((Jh - numerical_jacobian(fh, xh)).norm(), kTol);
+  EXPECT_LT((Jq - numerical_jacobian(fq, xq)).norm(), kTol);
+}
+
+// The builders' block Jacobians, assembled into a dense H, against differentiation of h(x) over
+// the whole state: checks the block placement too.
+TEST(Jacobians, MeasurementBuildersPlaceTheirBlocks) {
+  FilterState s(2);
+  s.x << 0.3, -0.2, 0.1, 1, 0, 0,  //
+      -1.4, 0.1, 15.2, 1, 0, 0,      //
+      1.6, -0.1, 16.9, 1, 0, 0;
+  s.P.setIdentity();
+  const CameraRig rig = tilted_rig(true);
+  s.add_landmark(LandmarkKind::Euclidean, Eigen::Vector3d(3, -2, 0.4), Eigen::MatrixXd::Zero(3, 18),
+                 Eigen::Matrix3d::Identity());
+  Vector6d y;
+  y << 1.6, -0.1, 16.9, 0.1, 0.05, 0.06;
+  s.add_landmark(LandmarkKind::InverseDepth, y, Eigen::MatrixXd::Zero(6, 21),
+                 Eigen::Matrix<double, 6, 6>::Identity());
+
+  auto dense = [&](const Measurement& m) {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m.dim(), s.dim());
+    for (const auto& b : m.blocks) H.middleCols(b.col, b.H.cols()) += b.H;
+    return H;
+  };
+  using Builder = std::function<Measurement(const FilterState&)>;
+  const std::vector<Builder> builders = {
+      [&](const FilterState& st) { return *landmark_measurement(st, st.landmarks()[0], 1, rig, {0, 0}, 3); },
+      [&](const FilterState& st) { return *landmark_measurement(st, st.landmarks()[1], 0, rig, {0, 0}, 3); },
+      [&](const FilterState& st) { return *lead_projection_measurement(st, 0, rig, {0, 0}, 3); },
+      [&](const FilterState& st) { return gps_measurement(st, Eigen::Vector3d::Zero(), 1.5); },
+      [&](const FilterState& st) { return altimeter_measurement(st, 1, rig, 0, 0.5); },
+      [&](const FilterState& st) { return range_measurement(st, 0, rig, 0, 0.5); },
+  };
+  for (size_t i = 0; i < builders.size(); ++i) {
+    const Measurement m = builders[i](s);
+    auto h = [&](const Eigen::VectorXd& x) -> Eigen::VectorXd {
+      FilterState t = s;
+      t.x = x;
+      return builders[i](t).h;
+    };
+    EXPECT_LT((dense(m) - numerical_jacobian(h, s.x)).norm(), kTol) << "builder " << i;
+  }
+}
