@@ -58,7 +58,8 @@ double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
 
 }  // namespace
 
-eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress) {
+eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress,
+                              const StateObserver& observer) {
   const auto wall0 = Clock::now();
   const bool single = scn.estimator.mode == sim::EstimatorMode::SingleUav;
   const sim::OpenLoopTruth truth(scn);
@@ -272,6 +273,7 @@ eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progre
 
     record_step(k, t, visible, static_cast<int>(cands.size()), accepted, initialised, t_predict,
                 t_update, t_init);
+    if (observer) observer(k, est.state());
     if (progress) progress(k, N);
   }
   rec.wall_time_s = std::chrono::duration<double>(Clock::now() - wall0).count();
