@@ -1,0 +1,297 @@
+// The `wingman` command line, run as a real process: exit codes, error messages that name the
+// file, line and key, the results directory it leaves (or does not leave), reproducibility.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "app_test_support.hpp"
+
+namespace wingman::app::test {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+// Names of the entries of a directory that look like a staging directory ("*.partial-*").
+std::vector<std::string> partial_entries(const fs::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.find(".partial-") != std::string::npos) out.push_back(name);
+  }
+  return out;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(fs::is_regular_file(kBinary)) << "wingman not built at " << kBinary;
+    ASSERT_TRUE(fs::is_regular_file(kSmoke)) << kSmoke;
+  }
+  // The output directory for a run, inside a directory of its own so that siblings can be listed.
+  fs::path out_dir(const std::string& name = "out") const { return tmp_ / name; }
+  // A copy of smoke.yaml, patched by `edit`, written into the temp directory.
+  template <class Edit>
+  fs::path patched_smoke(const std::string& file_name, Edit edit) const {
+    std::string text = read_file(kSmoke);
+    edit(text);
+    const fs::path p = tmp_ / file_name;
+    write_file(p, text);
+    return p;
+  }
+  // Expects a run that failed on the scenario: exit 2, `file:line:` and the key path in the
+  // message, no results directory and no staging directory left behind.
+  void expect_scenario_error(const fs::path& scn, int line, const std::string& key_path) {
+    const fs::path out = out_dir();
+    const RunResult r = run_wingman({"run", scn.string(), "--out", out.string(), "--no-plots", "-q"},
+                                    tmp_.path());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(scn.string() + ":" + std::to_string(line) + ":")) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(key_path)) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << "results directory created for a bad scenario";
+    EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
+  }
+
+  TempDir tmp_;
+};
+
+TEST_F(CliTest, MisspelledKeyExits2WithFileLineAndKeyPath) {
+  int line = -1;
+  const fs::path scn = patched_smoke("typo.yaml", [&](std::string& text) {
+    const auto gating = text.find("gating:");
+    ASSERT_NE(gating, std::string::npos);
+    line = replace_once(text, "probability:", "probabilty:", gating);
+  });
+  ASSERT_GT(line, 0);
+  expect_scenario_error(scn, line, "estimator.gating.probabilty");
+}
+
+TEST_F(CliTest, MisspelledKeyMessageIsOneLineOnStderr) {
+  // The message goes to stderr: with stdout discarded it is still there.
+  const fs::path scn = patched_smoke("typo.yaml", [&](std::string& text) {
+    replace_once(text, "probability:", "probabilty:", text.find("gating:"));
+  });
+  const fs::path log = tmp_ / "stderr.txt";
+  const std::string cmd = quote(kBinary.string()) + " run " + quote(scn.string()) + " --out " +
+                          quote(out_dir().string()) + " --no-plots -q > /dev/null 2> " +
+                          quote(log.string());
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  const std::string err = read_file(log);
+  EXPECT_THAT(err, HasSubstr("probabilty"));
+  EXPECT_EQ(lines_of(err).size(), 1u) << err;
+}
+
+TEST_F(CliTest, WrongTypeExits2NamingTheKey) {
+  int line = -1;
+  const fs::path scn = patched_smoke("wrong_type.yaml", [&](std::string& text) {
+    line = replace_top_level_value(text, "duration", "abc");
+  });
+  ASSERT_GT(line, 0);
+  expect_scenario_error(scn, line, "duration");
+}
+
+TEST_F(CliTest, OutOfRangeValueExits2NamingTheKey) {
+  int line = -1;
+  const fs::path scn = patched_smoke("bad_rate.yaml", [&](std::string& text) {
+    line = replace_top_level_value(text, "rate", "-1");
+  });
+  ASSERT_GT(line, 0);
+  expect_scenario_error(scn, line, "rate");
+}
+
+TEST_F(CliTest, NestedOutOfRangeValueNamesTheFullKeyPath) {
+  int line = -1;
+  const fs::path scn = patched_smoke("bad_prob.yaml", [&](std::string& text) {
+    line = replace_once(text, "probability: 0.999", "probability: 1.5", text.find("gating:"));
+  });
+  ASSERT_GT(line, 0);
+  expect_scenario_error(scn, line, "estimator.gating.probability");
+}
+
+TEST_F(CliTest, MissingScenarioFileFailsNamingTheFile) {
+  const fs::path missing = tmp_ / "no_such_scenario.yaml";
+  const fs::path out = out_dir();
+  const RunResult r =
+      run_wingman({"run", missing.string(), "--out", out.string(), "--no-plots", "-q"}, tmp_.path());
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(missing.string())) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
+}
+
+TEST_F(CliTest, UnknownVariantExits2) {
+  const fs::path out = out_dir();
+  const RunResult r = run_wingman(
+      {"run", kSmoke.string(), "--out", out.string(), "--no-plots", "-q", "--variant", "nope"},
+      tmp_.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("nope"));
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(CliTest, RunWritesCompleteResultsDirectory) {
+  const fs::path out = out_dir("results");
+  const RunResult r = run_wingman(
+      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::is_regular_file(out / ".wingman-results"));
+  EXPECT_TRUE(fs::is_regular_file(out / "scenario.yaml"));
+  EXPECT_EQ(read_file(out / "scenario.yaml"), read_file(kSmoke));
+  EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
+
+  // A selected variant is written into a folder named after it, as when all variants run.
+  const fs::path dir = out / "multi";
+  for (const char* f : {"metrics.json", "steps.csv", "landmarks.csv", "map.ply",
+                        "traj/lead.est.tum", "traj/lead.gt.tum", "traj/uav1.est.tum",
+                        "traj/uav1.gt.tum", "traj/uav2.est.tum", "traj/uav2.gt.tum"}) {
+    EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
+    if (fs::is_regular_file(dir / f)) EXPECT_GT(fs::file_size(dir / f), 0u) << f;
+  }
+  EXPECT_FALSE(fs::exists(out / "single")) << "--variant multi ran the single variant too";
+  for (const auto& e : fs::recursive_directory_iterator(out))
+    EXPECT_NE(e.path().extension(), ".png") << e.path();
+
+  // -q: nothing on stdout or stderr.
+  EXPECT_EQ(r.output, "");
+
+  const auto j = nlohmann::json::parse(read_file(dir / "metrics.json"));
+  const auto& mse = j.at("table4").at("total").at("lead").at("mse");
+  ASSERT_TRUE(mse.is_array());
+  ASSERT_EQ(mse.size(), 3u);
+  for (const auto& v : mse) {
+    ASSERT_TRUE(v.is_number()) << mse;
+    EXPECT_TRUE(std::isfinite(v.get<double>()));
+    EXPECT_GE(v.get<double>(), 0.0);
+  }
+  EXPECT_EQ(j.at("agents"), nlohmann::json({"lead", "uav1", "uav2"}));
+  EXPECT_EQ(j.at("scenario").at("variant"), "multi");
+
+  // TUM: one line per step plus the header, 8 columns.
+  const auto tum = lines_of(read_file(dir / "traj/lead.est.tum"));
+  ASSERT_GE(tum.size(), 2u);
+  EXPECT_EQ(tum.front().rfind("#", 0), 0u);
+  EXPECT_EQ(static_cast<long>(tum.size()) - 1, j.at("steps").get<long>());
+  std::istringstream row(tum[1]);
+  int cols = 0;
+  for (std::string tok; row >> tok;) ++cols;
+  EXPECT_EQ(cols, 8);
+
+  // Running again into the results directory replaces it.
+  const RunResult again = run_wingman(
+      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"});
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_TRUE(fs::is_regular_file(out / "multi" / "metrics.json"));
+  EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
+}
+
+TEST_F(CliTest, RefusesExistingDirectoryThatIsNotAResultsDirectory) {
+  const fs::path out = out_dir("precious");
+  fs::create_directories(out);
+  const std::string content = "do not delete: " + std::to_string(::getpid()) + "\n";
+  write_file(out / "notes.txt", content);
+  const auto before = fs::last_write_time(out / "notes.txt");
+
+  const RunResult r = run_wingman(
+      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(out.string()));
+  ASSERT_TRUE(fs::is_regular_file(out / "notes.txt"));
+  EXPECT_EQ(read_file(out / "notes.txt"), content);
+  EXPECT_EQ(fs::last_write_time(out / "notes.txt"), before);
+  std::set<std::string> entries;
+  for (const auto& e : fs::directory_iterator(out)) entries.insert(e.path().filename().string());
+  EXPECT_EQ(entries, std::set<std::string>{"notes.txt"});
+  EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
+}
+
+// steps.csv without its timing columns (wall-clock, never reproducible).
+std::string steps_without_timings(const fs::path& csv) {
+  const auto rows = lines_of(read_file(csv));
+  if (rows.empty()) return {};
+  auto split = [](const std::string& l) {
+    std::vector<std::string> f;
+    std::string cur;
+    for (char c : l) {
+      if (c == ',') {
+        f.push_back(cur);
+        cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+    f.push_back(cur);
+    return f;
+  };
+  const auto header = split(rows.front());
+  std::vector<bool> keep;
+  for (const auto& h : header) keep.push_back(!(h.rfind("t_", 0) == 0 && h.ends_with("_ms")));
+  EXPECT_EQ(std::count(keep.begin(), keep.end(), false), 3) << rows.front();
+  std::string out;
+  for (const auto& r : rows) {
+    const auto f = split(r);
+    EXPECT_EQ(f.size(), header.size());
+    for (std::size_t i = 0; i < f.size() && i < keep.size(); ++i)
+      if (keep[i]) out += f[i] + ",";
+    out += "\n";
+  }
+  return out;
+}
+
+TEST_F(CliTest, SameSeedSameNumbersOtherSeedOtherNumbers) {
+  auto run_seed = [&](const std::string& seed, const std::string& name) {
+    const fs::path out = out_dir(name);
+    const RunResult r = run_wingman({"run", "scenes/smoke.yaml", "--out", out.string(),
+                                     "--no-plots", "-q", "--variant", "multi", "--seed", seed});
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return out / "multi";
+  };
+  const fs::path a = run_seed("7", "a"), b = run_seed("7", "b"), c = run_seed("8", "c");
+  ASSERT_TRUE(fs::is_regular_file(a / "steps.csv"));
+  ASSERT_TRUE(fs::is_regular_file(b / "steps.csv"));
+  ASSERT_TRUE(fs::is_regular_file(c / "steps.csv"));
+
+  const std::string sa = steps_without_timings(a / "steps.csv");
+  EXPECT_EQ(sa, steps_without_timings(b / "steps.csv"));
+  EXPECT_NE(sa, steps_without_timings(c / "steps.csv"));
+  EXPECT_EQ(read_file(a / "landmarks.csv"), read_file(b / "landmarks.csv"));
+  for (const char* f : {"traj/lead.est.tum", "traj/uav1.est.tum", "traj/uav2.est.tum", "map.ply"})
+    EXPECT_EQ(read_file(a / f), read_file(b / f)) << f;
+
+  const auto ja = nlohmann::json::parse(read_file(a / "metrics.json"));
+  const auto jb = nlohmann::json::parse(read_file(b / "metrics.json"));
+  const auto jc = nlohmann::json::parse(read_file(c / "metrics.json"));
+  EXPECT_EQ(ja.at("scenario").at("seed"), 7);
+  EXPECT_EQ(jc.at("scenario").at("seed"), 8);
+  EXPECT_EQ(ja.at("table4"), jb.at("table4"));
+  EXPECT_EQ(ja.at("table5"), jb.at("table5"));
+  EXPECT_EQ(ja.at("table3"), jb.at("table3"));
+  EXPECT_NE(ja.at("table4").at("total"), jc.at("table4").at("total"));
+}
+
+TEST_F(CliTest, HelpExitsZeroAndMentionsRun) {
+  const RunResult top = run_wingman({"--help"}, tmp_.path());
+  EXPECT_EQ(top.exit_code, 0) << top.output;
+  EXPECT_THAT(top.output, HasSubstr("run"));
+  const RunResult run = run_wingman({"run", "--help"}, tmp_.path());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("run"));
+  EXPECT_THAT(run.output, HasSubstr("--out"));
+  EXPECT_THAT(run.output, HasSubstr("--seed"));
+}
+
+TEST_F(CliTest, BadCommandLineExits2) {
+  const RunResult none = run_wingman({}, tmp_.path());
+  EXPECT_EQ(none.exit_code, 2) << none.output;
+  const RunResult bogus = run_wingman({"run", kSmoke.string(), "--no-such-flag"}, tmp_.path());
+  EXPECT_EQ(bogus.exit_code, 2) << bogus.output;
+  EXPECT_THAT(bogus.output, HasSubstr("no-such-flag"));
+}
+
+}  // namespace
+}  // namespace wingman::app::test

@@ -1,0 +1,54 @@
+#!/usr/bin/env python3
+"""Markdown tables for docs/results.md from wingman results directories.
+
+usage: tools/seed_table.py RESULTS_ROOT VARIANT [VARIANT ...]
+RESULTS_ROOT holds one results directory per seed (seed1/, seed2/, ...), each with one
+subdirectory per variant as `wingman run` writes them. Prints, per variant, Table 4 and Table 5
+totals for every seed and their mean, min and max.
+"""
+import json
+import statistics
+import sys
+from pathlib import Path
+
+
+def load(root, variant):
+    runs = []
+    for d in sorted(Path(root).iterdir(), key=lambda p: (len(p.name), p.name)):
+        f = d / variant / "metrics.json"
+        if f.is_file():
+            runs.append((d.name, json.loads(f.read_text())))
+    return runs
+
+
+def row(name, values):
+    return "| " + name + " | " + " | ".join(f"{v:.4f}" for v in values) + " |"
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    root, variants = sys.argv[1], sys.argv[2:]
+    for variant in variants:
+        runs = load(root, variant)
+        if not runs:
+            sys.exit(f"no {variant}/metrics.json under {root}")
+        print(f"\n#### {variant}: Table 4 totals (MSE, m²) and Table 5 totals over {len(runs)} seeds\n")
+        print("| seed | Xh | Yh | Zh | X1 | Y1 | Z1 | lm X | lm Y | lm Z | lm init X | lm init Y | lm init Z |")
+        print("|---" * 13 + "|")
+        table = []
+        for name, m in runs:
+            t4 = m["table4"]["total"]
+            t5 = m["table5"]["total"]
+            vals = t4["lead"]["mse"] + t4["uav1"]["mse"] + t5["final_mse"] + t5["init_mse"]
+            vals = [float("nan") if v is None else v for v in vals]
+            table.append(vals)
+            print(row(name, vals))
+        cols = list(zip(*table))
+        print(row("**mean**", [statistics.fmean(c) for c in cols]))
+        print(row("min", [min(c) for c in cols]))
+        print(row("max", [max(c) for c in cols]))
+
+
+if __name__ == "__main__":
+    main()
