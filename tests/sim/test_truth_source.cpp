@@ -1,0 +1,78 @@
+// Truth trajectories and the synthetic measurement source.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include "sim/scenario.hpp"
+#include "sim/synthetic_source.hpp"
+#include "sim/truth.hpp"
+
+using namespace wingman::sim;
+
+namespace {
+Scenario paper_scenario() {
+  return parse_scenarios("duration: 60\nseed: 4\n", "inline.yaml").front();
+}
+}  // namespace
+
+TEST(Truth, LemniscateVelocityIsItsDerivative) {
+  const LeadTrajectorySpec spec;
+  for (double t : {0.0, 13.7, 70.0, 151.2}) {
+    const double h = 1e-4;
+    const Eigen::Vector3d num = (lemniscate(spec, t + h).position - lemniscate(spec, t - h).position) / (2 * h);
+    EXPECT_LT((num - lemniscate(spec, t).velocity).norm(), 1e-7) << "t = " << t;
+  }
+}
+
+TEST(Truth, AgentsStartAtTheirInitialPositionsAndShareTheCurve) {
+  const Scenario scn = paper_scenario();
+  const OpenLoopTruth truth(scn);
+  EXPECT_LT((truth.lead(0).position - Eigen::Vector3d(0, 0, 0)).norm(), 1e-12);
+  EXPECT_LT((truth.uav(0, 0).position - Eigen::Vector3d(-1.5, 0, 15)).norm(), 1e-12);
+  EXPECT_LT((truth.uav(1, 0).position - Eigen::Vector3d(1.5, 0, 17)).norm(), 1e-12);
+  // Open loop: the formation offset is constant.
+  EXPECT_LT((truth.uav(0, 42.0).position - truth.lead(42.0).position - Eigen::Vector3d(-1.5, 0, 15)).norm(), 1e-9);
+  const Eigen::Matrix3d R = truth.camera_R_CW(5.0);
+  EXPECT_LT((R * R.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  EXPECT_GT((R - truth.commanded_R_CW()).norm(), 1e-3);  // the gimbal error is there
+}
+
+TEST(SyntheticSource, FieldDensityAndReproducibility) {
+  const Scenario scn = paper_scenario();
+  const OpenLoopTruth truth(scn);
+  const auto a = make_landmark_field(scn, truth), b = make_landmark_field(scn, truth);
+  const Eigen::Vector4d box = truth.horizontal_extent();
+  const double m = scn.field.margin;
+  const double area = (box(2) - box(0) + 2 * m) * (box(3) - box(1) + 2 * m);
+  EXPECT_NEAR(static_cast<double>(a.size()), scn.field.density * area, 1.0);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.front(), b.front());
+  for (const auto& p : a) EXPECT_LE(std::abs(p.z() - scn.field.ground_height), scn.field.height_spread / 2);
+}
+
+TEST(SyntheticSource, OutliersAreFivePercentWithinFifteenPixels) {
+  const Scenario scn = paper_scenario();
+  const OpenLoopTruth truth(scn);
+  SyntheticSource src(scn, truth);
+  // Bind every point in view and observe them over many frames.
+  long total = 0, outliers = 0;
+  std::int64_t next_id = 0;
+  std::vector<std::int64_t> ids;
+  for (const auto& pp : src.cross_matches(0, 1, 0.0, 10000)) {
+    src.bind(next_id, pp.point);
+    ids.push_back(next_id++);
+  }
+  ASSERT_GT(ids.size(), 50u);
+  for (int k = 0; k < 200; ++k) {
+    for (const auto& o : src.observe_landmarks(0, 0.0, ids)) {
+      ++total;
+      const double e = (o.uv - o.true_uv).norm();
+      if (o.injected_outlier) {
+        ++outliers;
+        EXPECT_LE(e, scn.noise.outlier_max_px + 1e-9);
+      }
+    }
+  }
+  EXPECT_NEAR(static_cast<double>(outliers) / total, scn.noise.outlier_fraction, 0.005);
+  EXPECT_EQ(src.injected_outliers(0), outliers);
+}
