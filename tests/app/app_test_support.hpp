@@ -82,7 +82,10 @@ inline RunResult run_wingman(const std::vector<std::string>& args, const fs::pat
                              const fs::path& cwd = kSourceDir) {
   static int counter = 0;
   const fs::path log = capture_dir / ("wingman-output-" + std::to_string(counter++) + ".txt");
-  std::string cmd = "cd " + quote(cwd.string()) + " && " + quote(kBinary.string());
+  std::string cmd = "cd ";  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "lit" + s
+  cmd += quote(cwd.string());
+  cmd += " && ";
+  cmd += quote(kBinary.string());
   for (const auto& a : args) cmd += " " + quote(a);
   cmd += " > " + quote(log.string()) + " 2>&1";
   const int status = std::system(cmd.c_str());

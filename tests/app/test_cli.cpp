@@ -138,7 +138,8 @@ TEST_F(CliTest, UnknownVariantExits2) {
 TEST_F(CliTest, RunWritesCompleteResultsDirectory) {
   const fs::path out = out_dir("results");
   const RunResult r = run_wingman(
-      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"});
+      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"},
+      tmp_.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::is_regular_file(out / ".wingman-results"));
   EXPECT_TRUE(fs::is_regular_file(out / "scenario.yaml"));
@@ -151,11 +152,14 @@ TEST_F(CliTest, RunWritesCompleteResultsDirectory) {
                         "traj/lead.est.tum", "traj/lead.gt.tum", "traj/uav1.est.tum",
                         "traj/uav1.gt.tum", "traj/uav2.est.tum", "traj/uav2.gt.tum"}) {
     EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
-    if (fs::is_regular_file(dir / f)) EXPECT_GT(fs::file_size(dir / f), 0u) << f;
+    if (fs::is_regular_file(dir / f)) {
+      EXPECT_GT(fs::file_size(dir / f), 0u) << f;
+    }
   }
   EXPECT_FALSE(fs::exists(out / "single")) << "--variant multi ran the single variant too";
-  for (const auto& e : fs::recursive_directory_iterator(out))
+  for (const auto& e : fs::recursive_directory_iterator(out)) {
     EXPECT_NE(e.path().extension(), ".png") << e.path();
+  }
 
   // -q: nothing on stdout or stderr.
   EXPECT_EQ(r.output, "");
@@ -184,7 +188,8 @@ TEST_F(CliTest, RunWritesCompleteResultsDirectory) {
 
   // Running again into the results directory replaces it.
   const RunResult again = run_wingman(
-      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"});
+      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"},
+      tmp_.path());
   EXPECT_EQ(again.exit_code, 0) << again.output;
   EXPECT_TRUE(fs::is_regular_file(out / "multi" / "metrics.json"));
   EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
@@ -198,7 +203,8 @@ TEST_F(CliTest, RefusesExistingDirectoryThatIsNotAResultsDirectory) {
   const auto before = fs::last_write_time(out / "notes.txt");
 
   const RunResult r = run_wingman(
-      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"});
+      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"},
+      tmp_.path());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr(out.string()));
   ASSERT_TRUE(fs::is_regular_file(out / "notes.txt"));
@@ -236,8 +242,9 @@ std::string steps_without_timings(const fs::path& csv) {
   for (const auto& r : rows) {
     const auto f = split(r);
     EXPECT_EQ(f.size(), header.size());
-    for (std::size_t i = 0; i < f.size() && i < keep.size(); ++i)
+    for (std::size_t i = 0; i < f.size() && i < keep.size(); ++i) {
       if (keep[i]) out += f[i] + ",";
+    }
     out += "\n";
   }
   return out;
@@ -247,7 +254,8 @@ TEST_F(CliTest, SameSeedSameNumbersOtherSeedOtherNumbers) {
   auto run_seed = [&](const std::string& seed, const std::string& name) {
     const fs::path out = out_dir(name);
     const RunResult r = run_wingman({"run", "scenes/smoke.yaml", "--out", out.string(),
-                                     "--no-plots", "-q", "--variant", "multi", "--seed", seed});
+                                     "--no-plots", "-q", "--variant", "multi", "--seed", seed},
+                                    tmp_.path());
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return out / "multi";
   };
