@@ -53,7 +53,8 @@ struct OutlierCounts {
   std::string channel;
   long correspondences = 0;     // produced by the frontend (or the synthetic source)
   long injected = 0;            // synthetic outliers injected (0 with real matching)
-  long outliers = 0;            // correspondences > 3 px from the true projection
+  long outliers = 0;            // outliers among them: corrupted by the synthetic source, or
+                                // (real matching) > 3 px from the true projection
   long accepted = 0;            // correspondences the filter accepted
   long outliers_accepted = 0;   // outliers among those
 };

@@ -315,7 +315,7 @@ std::string format_summary(const Metrics& m, const RunRecord& run) {
     std::size_t cw = 7;
     for (const OutlierRow& r : m.table3) cw = std::max(cw, r.counts.channel.size());
     const int cwi = static_cast<int>(cw);
-    fmt::format_to(out, "\nTable 3: outliers (> 3 px from the true projection)\n");
+    fmt::format_to(out, "\nTable 3: outliers (synthetic: corrupted by the source; rendered: > 3 px from the true projection)\n");
     fmt::format_to(out, "{:<{}} {:>10} {:>9} {:>9} {:>10} {:>10} {:>9}\n", "channel", cwi,
                    "corresp.", "injected", "outliers", "accepted", "out.acc.", "fraction");
     for (const OutlierRow& r : m.table3) {
