@@ -89,14 +89,4 @@ Eigen::Vector3d FilterState::landmark_position(const LandmarkSlot& s) const {
   return inverse_depth_to_point(x.segment<6>(s.offset));
 }
 
-void FilterState::symmetrise() {
-  const int n = dim();
-  for (int c = 0; c < n; ++c)
-    for (int r = c + 1; r < n; ++r) {
-      const double v = 0.5 * (P(r, c) + P(c, r));
-      P(r, c) = v;
-      P(c, r) = v;
-    }
-}
-
 }  // namespace wingman::slam

@@ -51,9 +51,6 @@ class FilterState {
   // Euclidean position of any landmark (inverse depth converted, eq. of Montiel et al.).
   Eigen::Vector3d landmark_position(const LandmarkSlot& s) const;
 
-  // Makes P exactly symmetric (called after every update).
-  void symmetrise();
-
  private:
   int num_cameras_;
   std::vector<LandmarkSlot> landmarks_;

@@ -31,13 +31,13 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
   VisualUpdateResult res;
   std::vector<bool>* companion_accepted = &res.companion_accepted;
   std::vector<const Measurement*> extra;
-  if (companion_accepted) companion_accepted->assign(companions.size(), false);
+  companion_accepted->assign(companions.size(), false);
   for (size_t i = 0; i < companions.size(); ++i) {
     const auto& m = companions[i];
     if (mahalanobis_squared(m, innovation_covariance(s, m)) > gate_threshold(cfg.gate_probability, m.dim()))
       continue;
     extra.push_back(&m);
-    if (companion_accepted) (*companion_accepted)[i] = true;
+    (*companion_accepted)[i] = true;
   }
   res.accepted.assign(candidates.size(), false);
   const double gate2 = gate_threshold(cfg.gate_probability, 2);
@@ -57,16 +57,18 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
   }
   res.compatible = static_cast<int>(compatible.size());
   if (compatible.empty()) {
-    if (!extra.empty() && !ekf_update(s, extra) && companion_accepted)
-      companion_accepted->assign(companions.size(), false);
+    if (!extra.empty() && !ekf_update(s, extra)) companion_accepted->assign(companions.size(), false);
     return res;
   }
 
   if (!cfg.one_point_ransac) {
     std::vector<const Measurement*> batch = extra;
     for (int i : compatible) batch.push_back(&meas[i]);
-    if (ekf_update(s, batch))
+    if (ekf_update(s, batch)) {
       for (int i : compatible) res.accepted[i] = true;
+    } else {
+      companion_accepted->assign(companions.size(), false);
+    }
     return res;
   }
 
@@ -99,7 +101,7 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
     for (int i : best) batch.push_back(&meas[i]);
     if (ekf_update(s, batch)) {
       for (int i : best) res.accepted[i] = true;
-    } else if (companion_accepted) {
+    } else {
       companion_accepted->assign(companions.size(), false);
     }
   }
