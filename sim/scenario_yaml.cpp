@@ -473,6 +473,14 @@ void parse_uavs(const Ctx& ctx, const Field& f, std::vector<UavSpec>& uavs, Prov
   }
 }
 
+// A time window [from, to) of a phase or an outage: from >= 0 and to > from.
+void read_window(const Ctx& ctx, const Field& from, const Field& to, double& t_start, double& t_end) {
+  t_start = read_number(ctx, from, ge(0));
+  t_end = read_number(ctx, to);
+  if (!(t_end > t_start))
+    ctx.fail(to.loc(), fmt::format("must be greater than from ({}), got {}", t_start, to.node.Scalar()));
+}
+
 void parse_phases(const Ctx& ctx, const Field& f, std::vector<Phase>& phases, Provenance& prov) {
   if (!f.node.IsSequence())
     ctx.fail(f.loc(), fmt::format("expected a list of phases, got {}", describe(f.node)));
@@ -490,11 +498,7 @@ void parse_phases(const Ctx& ctx, const Field& f, std::vector<Phase>& phases, Pr
     if (nf) p.name = read_string(ctx, *nf);
     const Field from = m.require("from", item.loc());
     const Field to = m.require("to", item.loc());
-    p.t_start = read_number(ctx, from, ge(0));
-    p.t_end = read_number(ctx, to);
-    if (!(p.t_end > p.t_start))
-      ctx.fail(to.loc(),
-               fmt::format("must be greater than from ({}), got {}", p.t_start, to.node.Scalar()));
+    read_window(ctx, from, to, p.t_start, p.t_end);
     p.config = read_config(ctx, m.require("config", item.loc()));
     if (auto a = m.get("add")) p.add = read_sensor_list(ctx, *a);
     if (auto r = m.get("remove")) {
@@ -535,11 +539,7 @@ void parse_outages(const Ctx& ctx, const Field& f, std::vector<Outage>& outages,
     o.sensor = read_sensor(ctx, m.require("sensor", item.loc()));
     const Field from = m.require("from", item.loc());
     const Field to = m.require("to", item.loc());
-    o.t_start = read_number(ctx, from, ge(0));
-    o.t_end = read_number(ctx, to);
-    if (!(o.t_end > o.t_start))
-      ctx.fail(to.loc(),
-               fmt::format("must be greater than from ({}), got {}", o.t_start, to.node.Scalar()));
+    read_window(ctx, from, to, o.t_start, o.t_end);
     auto af = m.get("agent");
     if (af) o.agent = read_string(ctx, *af);
     outages.push_back(std::move(o));

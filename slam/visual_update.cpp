@@ -56,19 +56,18 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
     compatible.push_back(static_cast<int>(i));
   }
   res.compatible = static_cast<int>(compatible.size());
-  if (compatible.empty()) {
-    if (!extra.empty() && !ekf_update(s, extra)) companion_accepted->assign(companions.size(), false);
-    return res;
-  }
-
-  if (!cfg.one_point_ransac) {
+  // One joint update of the companions with the chosen candidates; on failure nothing is accepted.
+  auto joint_update = [&](const std::vector<int>& chosen) {
     std::vector<const Measurement*> batch = extra;
-    for (int i : compatible) batch.push_back(&meas[i]);
+    for (int i : chosen) batch.push_back(&meas[i]);
     if (ekf_update(s, batch)) {
-      for (int i : compatible) res.accepted[i] = true;
+      for (int i : chosen) res.accepted[i] = true;
     } else {
       companion_accepted->assign(companions.size(), false);
     }
+  };
+  if (compatible.empty() || !cfg.one_point_ransac) {
+    joint_update(compatible);
     return res;
   }
 
@@ -96,15 +95,7 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
     }
   }
   res.low_innovation_inliers = static_cast<int>(best.size());
-  {
-    std::vector<const Measurement*> batch = extra;
-    for (int i : best) batch.push_back(&meas[i]);
-    if (ekf_update(s, batch)) {
-      for (int i : best) res.accepted[i] = true;
-    } else {
-      companion_accepted->assign(companions.size(), false);
-    }
-  }
+  joint_update(best);
 
   // Rescue the high-innovation inliers with the corrected state and covariance.
   std::vector<Measurement> rescued;
