@@ -3,122 +3,22 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
-#include <filesystem>
-#include <optional>
-#include <stdexcept>
+#include <vector>
 
-#include "app/pipeline.hpp"
-#include "app/progress.hpp"
+#include "app/subcommand.hpp"
 #include "app/version.hpp"
-#include "eval/metrics.hpp"
-#include "eval/plots.hpp"
-#include "eval/results_dir.hpp"
-#include "eval/writers.hpp"
 #include "sim/scenario.hpp"
 
-namespace fs = std::filesystem;
-
 namespace wingman::app {
-
-namespace {
-
-// Bad input the user can fix: reported on one line, exit code 2.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-struct RunOptions {
-  std::string scenario;
-  std::string out;
-  std::optional<std::uint64_t> seed;
-  std::vector<std::string> variants;
-  bool no_plots = false;
-  bool quiet = false;
-};
-
-int run_command(const RunOptions& o) {
-  auto scenarios = sim::load_scenarios(o.scenario);
-  if (!o.variants.empty()) {
-    std::vector<sim::Scenario> keep;
-    for (const auto& name : o.variants) {
-      auto it = std::find_if(scenarios.begin(), scenarios.end(),
-                             [&](const sim::Scenario& s) { return s.variant == name; });
-      if (it == scenarios.end()) {
-        std::string known;
-        for (const auto& s : scenarios) known += (known.empty() ? "" : ", ") + s.variant;
-        throw UsageError(fmt::format("{}: no variant '{}' (variants: {})", o.scenario, name,
-                                     known.empty() ? "none" : known));
-      }
-      keep.push_back(*it);
-    }
-    scenarios = std::move(keep);
-  }
-  if (o.seed)
-    for (auto& s : scenarios) s.seed = *o.seed;
-  if (!o.no_plots && !eval::gnuplot_available())
-    throw UsageError("gnuplot with the pngcairo terminal was not found; install it (setup.sh does) "
-                     "or pass --no-plots");
-
-  const fs::path out = o.out.empty() ? fs::path("results") / scenarios.front().name : fs::path(o.out);
-  std::optional<eval::ResultsDir> staged;
-  try {
-    staged.emplace(out);  // refuses a directory that is not a wingman results directory
-  } catch (const std::runtime_error& e) {
-    throw UsageError(e.what());
-  }
-  eval::ResultsDir& results = *staged;
-  const bool nested = scenarios.size() > 1 || !scenarios.front().variant.empty();
-
-  std::vector<std::string> dirs, labels;
-  for (const auto& scn : scenarios) {
-    const std::string label = scn.variant.empty() ? scn.name : scn.name + "/" + scn.variant;
-    ProgressLine progress(fmt::format("[{}]", label), o.quiet);
-    const eval::RunRecord rec = run_synthetic(scn, [&](int k, int n) { progress.update(k, n, "steps"); });
-    progress.finish();
-
-    const fs::path dir = nested ? results.staging() / scn.variant : results.staging();
-    fs::create_directories(dir);
-    const eval::Metrics metrics = eval::compute_metrics(rec);
-    eval::write_results(metrics, rec, dir);
-    if (!o.no_plots) eval::write_plots(rec, dir);
-    if (!o.quiet) fmt::print("{}\n", eval::format_summary(metrics, rec));
-    dirs.push_back(dir.string());
-    labels.push_back(scn.variant.empty() ? scn.name : scn.variant);
-  }
-  if (!o.no_plots && dirs.size() > 1) {
-    // The paper's Fig. 10: the variants' errors side by side, for the lead and the first UAV.
-    for (const std::string agent : {"lead", "uav1"}) {
-      try {
-        eval::plot_comparison(dirs, labels, agent,
-                              (results.staging() / ("compare_" + agent + ".png")).string());
-      } catch (const std::invalid_argument&) {
-        // An agent some variant does not estimate: no comparison to draw.
-      }
-    }
-  }
-  fs::copy_file(o.scenario, results.staging() / "scenario.yaml");
-  results.commit();
-  if (!o.quiet) fmt::print("results: {}\n", out.string());
-  return 0;
-}
-
-}  // namespace
 
 int run_cli(int argc, char** argv) {
   CLI::App cli{"wingman: cooperative visual SLAM for UAV teams flying with a lead agent"};
   cli.set_version_flag("--version", kVersion);
   cli.require_subcommand(1);
 
-  RunOptions run;
-  auto* run_cmd = cli.add_subcommand(
-      "run", "Run a scenario end to end and write a results directory (metrics.json, TUM "
-             "trajectories, map PLY, per-step CSV, plots)");
-  run_cmd->add_option("scenario", run.scenario, "Scenario YAML file")->required();
-  run_cmd->add_option("--out,-o", run.out, "Results directory (default: results/<scenario name>)");
-  run_cmd->add_option("--seed", run.seed, "Override the scenario's seed");
-  run_cmd->add_option("--variant", run.variants, "Run only these variants (repeatable)");
-  run_cmd->add_flag("--no-plots", run.no_plots, "Skip the PNG plots (no gnuplot needed)");
-  run_cmd->add_flag("--quiet,-q", run.quiet, "No progress line and no summary");
+  const std::vector<Subcommand> commands = {
+      add_run(cli),
+  };
 
   try {
     cli.parse(argc, argv);
@@ -127,7 +27,8 @@ int run_cli(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
   try {
-    if (*run_cmd) return run_command(run);
+    for (const auto& c : commands)
+      if (c.cli->parsed()) return c.run();
   } catch (const sim::ScenarioError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 2;

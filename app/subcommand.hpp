@@ -1,0 +1,28 @@
+// One `wingman` subcommand. Each lives in its own app/cmd_<name>.cpp, exposes one add_<name>()
+// that declares its options on the parent CLI::App, and is listed once in app/commands.cpp;
+// adding a subcommand never touches the others.
+#pragma once
+
+#include <functional>
+#include <stdexcept>
+
+namespace CLI {
+class App;
+}
+
+namespace wingman::app {
+
+// Bad input the user can fix (a flag, a path, a variant name): one line, exit code 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Subcommand {
+  CLI::App* cli = nullptr;     // the parsed subcommand
+  std::function<int()> run;    // runs it after parsing; returns the exit code
+};
+
+Subcommand add_run(CLI::App& parent);  // app/cmd_run.cpp
+// Further subcommands declare their add_<name>() here.
+
+}  // namespace wingman::app
