@@ -30,6 +30,7 @@ slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
   s.range_sigma = e.range_sigma;
   s.initial_position_sigma = e.initial_position_sigma;
   s.initial_velocity_sigma = e.initial_velocity_sigma;
+  s.gimbal_time_constant = e.orientation_time_constant;
   s.gate_probability = e.gate_probability;
   s.visual.one_point_ransac = e.one_point_ransac;
   s.visual.inlier_px = e.ransac_inlier_px;
@@ -49,7 +50,7 @@ slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
 
 // NEES (eq. 67) over the agents' positions and velocities.
 double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
-  const int d = s.agent_dim();
+  const int d = s.kinematic_dim();
   const Eigen::VectorXd e = truth - s.x.head(d);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(s.P.topLeftCorner(d, d));
   if (ldlt.info() != Eigen::Success) return eval::kNaN;
@@ -114,7 +115,7 @@ eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progre
     st.t = t;
     st.phase = scn.phase_at(t);
     const auto& s = est.state();
-    Eigen::VectorXd x_true(s.agent_dim());
+    Eigen::VectorXd x_true(s.kinematic_dim());
     auto agent = [&](const sim::KinematicState& tr, int pos) {
       eval::AgentStep a;
       a.p_true = tr.position;
@@ -129,7 +130,7 @@ eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progre
     agent(truth.lead(t), slam::FilterState::lead_pos());
     for (int j = 0; j < ncam; ++j) agent(truth.camera(cam_uav[j], t), slam::FilterState::cam_pos(j));
     st.nees = k == 0 ? eval::kNaN : agent_nees(s, x_true);
-    st.nees_dof = s.agent_dim();
+    st.nees_dof = s.kinematic_dim();
     st.landmarks = est.num_landmarks();
     st.landmarks_visible = visible;
     st.matches_offered = offered;

@@ -115,6 +115,9 @@ struct EstimatorSpec {
   // Gimbal pointing noise about the camera's x and y axes that the filter assumes (rad); the
   // truth's gimbal error is never given to it. 0 trusts R_CW exactly.
   double orientation_sigma = 0.0;
+  // Correlation time (s) of that pointing error. > 0: the filter estimates each camera's error as
+  // a Gauss-Markov state; 0: it treats it as white noise, marginalised in every update.
+  double orientation_time_constant = 0.0;
   // Initial uncertainty of the agents (the paper: known exactly).
   double initial_position_sigma = 1e-3;
   double initial_velocity_sigma = 1e-3;

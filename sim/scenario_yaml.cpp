@@ -572,12 +572,13 @@ void parse_estimator(const Ctx& ctx, const Field& f, EstimatorSpec& e, Provenanc
   }
   if (auto rf = m.get("measurement_noise")) {
     MapView r(ctx, *rf, {"pixel_sigma", "gps_sigma", "altimeter_sigma", "range_sigma",
-                         "orientation_sigma"});
+                         "orientation_sigma", "orientation_time_constant"});
     num(ctx, r, "pixel_sigma", e.pixel_sigma, ge(0));
     num(ctx, r, "gps_sigma", e.gps_sigma, ge(0));
     num(ctx, r, "altimeter_sigma", e.altimeter_sigma, ge(0));
     num(ctx, r, "range_sigma", e.range_sigma, ge(0));
     num(ctx, r, "orientation_sigma", e.orientation_sigma, ge(0));
+    num(ctx, r, "orientation_time_constant", e.orientation_time_constant, ge(0));
   }
   if (auto inf = m.get("initial_sigma")) {
     MapView s(ctx, *inf, {"position", "velocity"});

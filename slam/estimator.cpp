@@ -12,7 +12,10 @@ Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
                      const std::vector<AgentInit>& camera_init, const EstimatorSettings& settings)
     : cams_(std::move(cameras)),
       cfg_(settings),
-      s_(static_cast<int>(cams_.size())),
+      s_(static_cast<int>(cams_.size()),
+         settings.gimbal_time_constant > 0 &&
+             std::any_of(cams_.begin(), cams_.end(),
+                         [](const CameraRig& c) { return c.orientation_sigma > 0; })),
       rng_(settings.seed) {
   if (camera_init.size() != cams_.size())
     throw std::invalid_argument("Estimator: one initial state per camera");
@@ -26,6 +29,9 @@ Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
   };
   set(FilterState::lead_pos(), lead);
   for (size_t j = 0; j < cams_.size(); ++j) set(FilterState::cam_pos(static_cast<int>(j)), camera_init[j]);
+  for (int j = 0; j < num_cameras(); ++j)
+    if (const int g = s_.gimbal(j); g >= 0)
+      s_.P.block<2, 2>(g, g).diagonal().setConstant(cams_[j].orientation_sigma * cams_[j].orientation_sigma);
   cfg_.visual.sigma_px = cfg_.pixel_sigma;
   cfg_.visual.gate_probability = cfg_.gate_probability;
   cfg_.cooperative.sigma_px = cfg_.pixel_sigma;
@@ -34,13 +40,15 @@ Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
 
 void Estimator::predict(double dt) {
   predict_constant_velocity(s_, dt, cfg_.accel_sigma_lead, cfg_.accel_sigma_uav);
+  for (int j = 0; j < num_cameras(); ++j)
+    predict_gimbal_error(s_, j, dt, cams_[j].orientation_sigma, cfg_.gimbal_time_constant);
 }
 
 std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
   std::vector<LandmarkPrediction> out;
   const CameraRig& rig = cams_[cam];
   for (const auto& lm : s_.landmarks()) {
-    auto uv = predict_landmark_pixel(s_.x, lm, cam, rig);
+    auto uv = predict_landmark_pixel(s_, s_.x, lm, cam, rig);
     if (!uv || !rig.model.in_image(*uv, cfg_.image_margin_px)) continue;
     auto m = landmark_measurement(s_, lm, cam, rig, *uv, cfg_.pixel_sigma);
     if (!m) continue;

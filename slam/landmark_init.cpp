@@ -76,28 +76,54 @@ std::optional<Triangulation> triangulate_two_views(const CameraRig& cam_a, const
   return t;
 }
 
-InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& rig_a,
-                                   const Eigen::Vector2d& uv_a, int cam_b, const CameraRig& rig_b,
-                                   const Eigen::Vector2d& uv_b, const CooperativeInitSettings& cfg) {
+namespace {
+// A new landmark's covariance with the state and its own (eq. 52), from the Jacobians of its
+// parameters with respect to the state blocks it depends on (columns `col`) and its pixel noise.
+struct StateDependence {
+  int col;
+  Eigen::MatrixXd J;  // rows: landmark parameters; cols: the block's dimension
+};
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> augmented_covariance(
+    const FilterState& s, const std::vector<StateDependence>& deps, const Eigen::MatrixXd& pixel_cov) {
+  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(pixel_cov.rows(), s.dim());
+  for (const auto& d : deps) cross.noalias() += d.J * s.P.middleRows(d.col, d.J.cols());
+  Eigen::MatrixXd cov = pixel_cov;
+  for (const auto& d : deps) cov.noalias() += cross.middleCols(d.col, d.J.cols()) * d.J.transpose();
+  return {std::move(cross), std::move(cov)};
+}
+}  // namespace
+
+InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& commanded_a,
+                                   const Eigen::Vector2d& uv_a, int cam_b,
+                                   const CameraRig& commanded_b, const Eigen::Vector2d& uv_b,
+                                   const CooperativeInitSettings& cfg) {
+  const CameraRig rig_a = estimated_rig(s.x, s.gimbal(cam_a), commanded_a);
+  const CameraRig rig_b = estimated_rig(s.x, s.gimbal(cam_b), commanded_b);
   const int pa = FilterState::cam_pos(cam_a), pb = FilterState::cam_pos(cam_b);
   const Eigen::Vector3d x_a = s.x.segment<3>(pa), x_b = s.x.segment<3>(pb);
   auto t = triangulate_two_views(rig_a, x_a, uv_a, rig_b, x_b, uv_b);
   if (!t) return {std::nullopt, "degenerate"};
-  if ((rig_a.R_CW * (t->point - x_a)).z() <= 0 || (rig_b.R_CW * (t->point - x_b)).z() <= 0)
-    return {std::nullopt, "negative depth"};
+  const Eigen::Vector3d pC_a = rig_a.R_CW * (t->point - x_a), pC_b = rig_b.R_CW * (t->point - x_b);
+  if (pC_a.z() <= 0 || pC_b.z() <= 0) return {std::nullopt, "negative depth"};
   if (t->parallax_rad < cfg.min_parallax_deg * kPi / 180) return {std::nullopt, "low parallax"};
   if (!(t->reprojection_px <= cfg.max_reprojection_px)) return {std::nullopt, "reprojection"};
 
   // eq. 52: P_new = J diag(P, R) J^T with J = [d/dx_c^a, d/dx_c^b | d/d(uv_a, uv_b)].
-  const Eigen::Matrix3d Ja = t->J.block<3, 3>(0, 0), Jb = t->J.block<3, 3>(0, 3);
-  const Eigen::Matrix<double, 3, 4> Jz = t->J.rightCols<4>();
-  const Eigen::MatrixXd cross = Ja * s.P.middleRows(pa, 3) + Jb * s.P.middleRows(pb, 3);
-  const Eigen::Matrix2d Ra = pixel_covariance(rig_a, rig_a.R_CW * (t->point - x_a), cfg.sigma_px);
-  const Eigen::Matrix2d Rb = pixel_covariance(rig_b, rig_b.R_CW * (t->point - x_b), cfg.sigma_px);
-  const Eigen::Matrix3d cov = cross.middleCols(pa, 3) * Ja.transpose() +
-                              cross.middleCols(pb, 3) * Jb.transpose() +
-                              Jz.leftCols<2>() * Ra * Jz.leftCols<2>().transpose() +
-                              Jz.rightCols<2>() * Rb * Jz.rightCols<2>().transpose();
+  const Eigen::Matrix<double, 3, 2> Jza = t->J.block<3, 2>(0, 6), Jzb = t->J.block<3, 2>(0, 8);
+  std::vector<StateDependence> deps = {{pa, t->J.block<3, 3>(0, 0)}, {pb, t->J.block<3, 3>(0, 3)}};
+  // An estimated gimbal error turns the observed ray as a pixel shift would:
+  // d uv = -(d uv / d a) d a, with d uv / d a taken along the observed pixel's ray.
+  auto ray = [](const CameraRig& rig, const Eigen::Vector2d& uv) {
+    const Eigen::Vector2d xn = rig.model.unproject_normalised(uv);
+    return Eigen::Vector3d(xn.x(), xn.y(), 1.0);
+  };
+  if (const int g = s.gimbal(cam_a); g >= 0)
+    deps.push_back({g, -Jza * pixel_gimbal_jacobian(rig_a.model, s.x(g), ray(rig_a, uv_a))});
+  if (const int g = s.gimbal(cam_b); g >= 0)
+    deps.push_back({g, -Jzb * pixel_gimbal_jacobian(rig_b.model, s.x(g), ray(rig_b, uv_b))});
+  const Eigen::Matrix3d pixel_cov = Jza * pixel_covariance(rig_a, pC_a, cfg.sigma_px) * Jza.transpose() +
+                                    Jzb * pixel_covariance(rig_b, pC_b, cfg.sigma_px) * Jzb.transpose();
+  const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
   return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
 }
 
@@ -120,21 +146,22 @@ Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x
   return y;
 }
 
-InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& rig,
+InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& commanded,
                                      const Eigen::Vector2d& uv, const InverseDepthInitSettings& cfg) {
+  const CameraRig rig = estimated_rig(s.x, s.gimbal(cam), commanded);
   const int pc = FilterState::cam_pos(cam);
   Eigen::Matrix<double, 6, 5> J;
   const Vector6d y = inverse_depth_from_pixel(rig, s.x.segment<3>(pc), uv, cfg.rho, &J);
   // The anchor is the camera position: it inherits the camera's rows of P.
-  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(6, s.dim());
-  cross.topRows(3) = s.P.middleRows(pc, 3);
-  Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Zero();
-  cov.topLeftCorner<3, 3>() = s.P.block<3, 3>(pc, pc);
-  const Eigen::Matrix2d Juv = J.block<2, 2>(3, 3);
+  std::vector<StateDependence> deps = {{pc, J.leftCols<3>()}};
+  const Eigen::Matrix<double, 6, 2> Juv = J.rightCols<2>();
   const Eigen::Vector2d xn = rig.model.unproject_normalised(uv);
-  const Eigen::Matrix2d Ruv = pixel_covariance(rig, Eigen::Vector3d(xn.x(), xn.y(), 1.0), cfg.sigma_px);
-  cov.block<2, 2>(3, 3) = Juv * Ruv * Juv.transpose();
-  cov(5, 5) = cfg.sigma_rho * cfg.sigma_rho;
+  const Eigen::Vector3d ray_C(xn.x(), xn.y(), 1.0);
+  if (const int g = s.gimbal(cam); g >= 0)
+    deps.push_back({g, -Juv * pixel_gimbal_jacobian(rig.model, s.x(g), ray_C)});
+  Eigen::Matrix<double, 6, 6> pixel_cov = Juv * pixel_covariance(rig, ray_C, cfg.sigma_px) * Juv.transpose();
+  pixel_cov(5, 5) = cfg.sigma_rho * cfg.sigma_rho;  // the depth prior, independent of the state
+  const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
   return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
 }
 

@@ -42,8 +42,9 @@ struct InitOutcome {
   std::optional<LandmarkId> id;
   std::string rejected_because;
 };
-InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& rig_a,
-                                   const Eigen::Vector2d& uv_a, int cam_b, const CameraRig& rig_b,
+InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& commanded_a,
+                                   const Eigen::Vector2d& uv_a, int cam_b,
+                                   const CameraRig& commanded_b,
                                    const Eigen::Vector2d& uv_b, const CooperativeInitSettings& cfg);
 
 struct InverseDepthInitSettings {
@@ -57,7 +58,7 @@ struct InverseDepthInitSettings {
 Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x_c,
                                   const Eigen::Vector2d& uv, double rho,
                                   Eigen::Matrix<double, 6, 5>* J = nullptr);
-InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& rig,
+InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& commanded,
                                      const Eigen::Vector2d& uv, const InverseDepthInitSettings& cfg);
 
 // Converts inverse-depth landmarks whose linearity index (seen from camera `cam`) is below the

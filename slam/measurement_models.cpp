@@ -2,6 +2,10 @@
 
 #include <cmath>
 
+#include <Eigen/Geometry>
+
+#include "geometry/rotation.hpp"
+
 namespace wingman::slam {
 
 std::optional<Eigen::Vector2d> project_point(const CameraRig& cam, const Eigen::Vector3d& x_c,
@@ -66,6 +70,24 @@ Eigen::Matrix<double, 2, 2> pixel_rotation_jacobian(const geometry::PinholeCamer
   return Jp * dp;
 }
 
+CameraRig estimated_rig(const Eigen::VectorXd& x, int gimbal_col, const CameraRig& cam) {
+  if (gimbal_col < 0) return cam;
+  CameraRig rig = cam;
+  rig.R_CW = geometry::rot_x(x(gimbal_col)) * geometry::rot_y(x(gimbal_col + 1)) * cam.R_CW;
+  rig.orientation_sigma = 0;
+  return rig;
+}
+
+Eigen::Matrix2d pixel_gimbal_jacobian(const geometry::PinholeCamera& model, double a_x,
+                                      const Eigen::Vector3d& p_C) {
+  Eigen::Matrix<double, 2, 3> Jp;
+  model.project(p_C, &Jp);
+  Eigen::Matrix<double, 3, 2> dp;
+  dp.col(0) = Eigen::Vector3d::UnitX().cross(p_C);
+  dp.col(1) = Eigen::Vector3d(0, std::cos(a_x), std::sin(a_x)).cross(p_C);
+  return Jp * dp;
+}
+
 Eigen::Matrix2d pixel_covariance(const CameraRig& cam, const Eigen::Vector3d& p_C, double sigma_px) {
   Eigen::Matrix2d R = sigma_px * sigma_px * Eigen::Matrix2d::Identity();
   if (cam.orientation_sigma > 0) {
@@ -76,8 +98,14 @@ Eigen::Matrix2d pixel_covariance(const CameraRig& cam, const Eigen::Vector3d& p_
 }
 
 namespace {
-void attach_orientation_noise(Measurement& m, int cam_index, const CameraRig& cam,
-                              const Eigen::Vector3d& p_C) {
+// The gimbal's pointing error: a Jacobian block on its states when the filter estimates it,
+// otherwise noise shared by the camera's projections of this instant.
+void attach_orientation(Measurement& m, const FilterState& s, int cam_index, const CameraRig& cam,
+                        const Eigen::Vector3d& p_C) {
+  if (const int g = s.gimbal(cam_index); g >= 0) {
+    m.blocks.push_back({g, pixel_gimbal_jacobian(cam.model, s.x(g), p_C)});
+    return;
+  }
   if (cam.orientation_sigma <= 0) return;
   m.camera = cam_index;
   m.orientation_sigma = cam.orientation_sigma;
@@ -93,8 +121,9 @@ SmallSq isotropic(int dim, double sigma) {
 }  // namespace
 
 std::optional<Measurement> landmark_measurement(const FilterState& s, const LandmarkSlot& lm,
-                                                int cam_index, const CameraRig& cam,
+                                                int cam_index, const CameraRig& rig,
                                                 const Eigen::Vector2d& z, double sigma_px) {
+  const CameraRig cam = estimated_rig(s.x, s.gimbal(cam_index), rig);
   const Eigen::Vector3d x_c = s.x.segment<3>(FilterState::cam_pos(cam_index));
   Measurement m;
   m.z = z;
@@ -106,7 +135,7 @@ std::optional<Measurement> landmark_measurement(const FilterState& s, const Land
     if (!uv) return std::nullopt;
     m.h = *uv;
     m.blocks.push_back({lm.offset, J_xa});
-    attach_orientation_noise(m, cam_index, cam, cam.R_CW * (s.x.segment<3>(lm.offset) - x_c));
+    attach_orientation(m, s, cam_index, cam, cam.R_CW * (s.x.segment<3>(lm.offset) - x_c));
   } else {
     Eigen::Matrix<double, 2, 6> J_y;
     const Vector6d y = s.x.segment<6>(lm.offset);
@@ -115,16 +144,17 @@ std::optional<Measurement> landmark_measurement(const FilterState& s, const Land
     m.h = *uv;
     m.blocks.push_back({lm.offset, J_y});
     // The rotation Jacobian is scale invariant: the scaled point rho (x0 - x_c) + m will do.
-    attach_orientation_noise(m, cam_index, cam,
-                             cam.R_CW * (y(5) * (y.head<3>() - x_c) + inverse_depth_direction(y(3), y(4))));
+    attach_orientation(m, s, cam_index, cam,
+                       cam.R_CW * (y(5) * (y.head<3>() - x_c) + inverse_depth_direction(y(3), y(4))));
   }
   m.blocks.push_back({FilterState::cam_pos(cam_index), J_xc});
   return m;
 }
 
 std::optional<Measurement> lead_projection_measurement(const FilterState& s, int cam_index,
-                                                       const CameraRig& cam,
+                                                       const CameraRig& rig,
                                                        const Eigen::Vector2d& z, double sigma_px) {
+  const CameraRig cam = estimated_rig(s.x, s.gimbal(cam_index), rig);
   Eigen::Matrix<double, 2, 3> J_xc, J_xh;
   auto uv = project_point(cam, s.x.segment<3>(FilterState::cam_pos(cam_index)),
                           s.x.segment<3>(FilterState::lead_pos()), &J_xc, &J_xh);  // eq. 5-6
@@ -135,8 +165,8 @@ std::optional<Measurement> lead_projection_measurement(const FilterState& s, int
   m.R = isotropic(2, sigma_px);
   m.blocks.push_back({FilterState::lead_pos(), J_xh});
   m.blocks.push_back({FilterState::cam_pos(cam_index), J_xc});
-  attach_orientation_noise(m, cam_index, cam,
-                           cam.R_CW * (s.x.segment<3>(FilterState::lead_pos()) -
+  attach_orientation(m, s, cam_index, cam,
+                     cam.R_CW * (s.x.segment<3>(FilterState::lead_pos()) -
                                        s.x.segment<3>(FilterState::cam_pos(cam_index))));
   return m;
 }
@@ -175,9 +205,10 @@ Measurement range_measurement(const FilterState& s, int cam_index, const CameraR
   return m;
 }
 
-std::optional<Eigen::Vector2d> predict_landmark_pixel(const Eigen::VectorXd& x,
+std::optional<Eigen::Vector2d> predict_landmark_pixel(const FilterState& s, const Eigen::VectorXd& x,
                                                       const LandmarkSlot& lm, int cam_index,
-                                                      const CameraRig& cam) {
+                                                      const CameraRig& rig) {
+  const CameraRig cam = estimated_rig(x, s.gimbal(cam_index), rig);
   const Eigen::Vector3d x_c = x.segment<3>(FilterState::cam_pos(cam_index));
   if (lm.kind == LandmarkKind::Euclidean) return project_point(cam, x_c, x.segment<3>(lm.offset));
   return project_inverse_depth(cam, x_c, x.segment<6>(lm.offset));

@@ -49,6 +49,15 @@ struct CameraRig {
   double orientation_sigma = 0;
 };
 
+// The camera as the filter sees it at state x: when the state holds camera j's gimbal error
+// (gimbal_col >= 0), R_CW becomes R_x(a_x) R_y(a_y) R_CW, the truth's parametrisation of the error
+// (DESIGN.md §2), and the error is no longer marginalised as noise (orientation_sigma = 0).
+CameraRig estimated_rig(const Eigen::VectorXd& x, int gimbal_col, const CameraRig& cam);
+// d uv / d(a_x, a_y) of the projection of p_C = R_x(a_x) R_y(a_y) R_CW (p_W - x_c), at p_C:
+// d p_C / d a_x = [e_x]x p_C and d p_C / d a_y = [R_x(a_x) e_y]x p_C.
+Eigen::Matrix2d pixel_gimbal_jacobian(const geometry::PinholeCamera& model, double a_x,
+                                      const Eigen::Vector3d& p_C);
+
 // d uv / d(small rotation of the camera about its x and y axes) at a point p_C in the camera
 // frame: p_C -> (I + [w]x) p_C.
 Eigen::Matrix<double, 2, 2> pixel_rotation_jacobian(const geometry::PinholeCamera& model,
@@ -87,7 +96,7 @@ Measurement range_measurement(const FilterState& s, int cam_index, const CameraR
 
 // The predicted pixel of a landmark in a camera for a state vector x laid out as `s`'s, without
 // building a measurement (1-point RANSAC evaluates hypotheses this way).
-std::optional<Eigen::Vector2d> predict_landmark_pixel(const Eigen::VectorXd& x,
+std::optional<Eigen::Vector2d> predict_landmark_pixel(const FilterState& s, const Eigen::VectorXd& x,
                                                       const LandmarkSlot& lm, int cam_index,
                                                       const CameraRig& cam);
 

@@ -1,5 +1,7 @@
 #include "slam/motion_model.hpp"
 
+#include <cmath>
+
 namespace wingman::slam {
 
 void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav) {
@@ -14,6 +16,16 @@ void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, d
   propagate(FilterState::lead_pos(), FilterState::lead_vel(), sigma_a_lead);
   for (int j = 0; j < s.num_cameras(); ++j)
     propagate(FilterState::cam_pos(j), FilterState::cam_vel(j), sigma_a_uav);
+}
+
+void predict_gimbal_error(FilterState& s, int j, double dt, double sigma, double tau) {
+  const int g = s.gimbal(j);
+  if (g < 0) return;
+  const double phi = std::exp(-dt / tau);
+  s.x.segment<2>(g) *= phi;
+  s.P.middleRows(g, 2) *= phi;
+  s.P.middleCols(g, 2) *= phi;
+  s.P.block<2, 2>(g, g).diagonal().array() += (1 - phi * phi) * sigma * sigma;
 }
 
 }  // namespace wingman::slam

@@ -10,4 +10,11 @@ namespace wingman::slam {
 // sigma_a_*: std of the white acceleration (m/s^2); the velocity takes noise a dt (eq. 34).
 void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav);
 
+// Camera j's gimbal error, when the state holds it, as a first-order Gauss-Markov process with
+// stationary std `sigma` (rad) and correlation time `tau` (s): a <- exp(-dt/tau) a, with noise
+// (1 - exp(-2 dt/tau)) sigma^2 so that its variance tends to sigma^2. A slowly varying pointing
+// error is not white: treating it as white noise makes the filter believe every frame's
+// landmarks anew and overconfident. A no-op without gimbal states.
+void predict_gimbal_error(FilterState& s, int j, double dt, double sigma, double tau);
+
 }  // namespace wingman::slam

@@ -7,7 +7,8 @@
 
 namespace wingman::slam {
 
-FilterState::FilterState(int num_cameras) : num_cameras_(num_cameras) {
+FilterState::FilterState(int num_cameras, bool gimbal_states)
+    : num_cameras_(num_cameras), gimbal_states_(gimbal_states) {
   if (num_cameras < 1) throw std::invalid_argument("FilterState: at least one camera");
   x = Eigen::VectorXd::Zero(agent_dim());
   P = Eigen::MatrixXd::Zero(agent_dim(), agent_dim());

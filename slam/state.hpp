@@ -1,5 +1,7 @@
 // The filter state of paper eq. 2 and its covariance: x = [x_h, v_h, x_c^1, v_c^1, ..., x_a^i],
-// for any number of cameras. Landmarks are Euclidean (3 parameters, eq. 2) or inverse depth
+// for any number of cameras, optionally with each gimbal's pointing error (two angles per camera,
+// after the agents and before the landmarks) when the filter estimates it instead of treating it
+// as white noise. Landmarks are Euclidean (3 parameters, eq. 2) or inverse depth
 // (6 parameters [x0 y0 z0 theta phi rho], Montiel et al. 2006) for the single-UAV baseline.
 #pragma once
 
@@ -23,7 +25,7 @@ struct LandmarkSlot {
 
 class FilterState {
  public:
-  explicit FilterState(int num_cameras);
+  explicit FilterState(int num_cameras, bool gimbal_states = false);
 
   Eigen::VectorXd x;
   Eigen::MatrixXd P;
@@ -33,7 +35,11 @@ class FilterState {
   static constexpr int lead_vel() { return 3; }
   static int cam_pos(int j) { return 6 + 6 * j; }
   static int cam_vel(int j) { return 9 + 6 * j; }
-  int agent_dim() const { return 6 + 6 * num_cameras_; }  // lead and cameras, pos + vel
+  int kinematic_dim() const { return 6 + 6 * num_cameras_; }  // lead and cameras, pos + vel
+  // First of camera j's two gimbal angles (about its x and y axes), or -1 when not estimated.
+  int gimbal(int j) const { return gimbal_states_ ? kinematic_dim() + 2 * j : -1; }
+  bool has_gimbal_states() const { return gimbal_states_; }
+  int agent_dim() const { return kinematic_dim() + (gimbal_states_ ? 2 * num_cameras_ : 0); }
   int dim() const { return static_cast<int>(x.size()); }
 
   const std::vector<LandmarkSlot>& landmarks() const { return landmarks_; }
@@ -53,6 +59,7 @@ class FilterState {
 
  private:
   int num_cameras_;
+  bool gimbal_states_;
   std::vector<LandmarkSlot> landmarks_;
   LandmarkId next_id_ = 0;
 };

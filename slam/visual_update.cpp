@@ -82,7 +82,7 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
     std::vector<int> inliers;
     for (int j : compatible) {
       const auto& c = candidates[j];
-      auto uv = predict_landmark_pixel(x_h, *s.find(c.id), c.cam, cams[c.cam]);
+      auto uv = predict_landmark_pixel(s, x_h, *s.find(c.id), c.cam, cams[c.cam]);
       if (uv && (*uv - c.uv).squaredNorm() < inlier2) inliers.push_back(j);
     }
     ++res.hypotheses;

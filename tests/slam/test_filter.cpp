@@ -55,6 +55,36 @@ TEST(Prediction, EqualsDenseAPAtPlusQ) {
   EXPECT_LT((s.P - (A * before.P * A.transpose() + Q)).norm(), 1e-12);
 }
 
+// The gimbal errors' Gauss-Markov prediction equals the dense F P F^T + Q, and with no
+// measurement their variance tends to the stationary sigma^2.
+TEST(Prediction, GimbalErrorIsGaussMarkov) {
+  FilterState s(2, true);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n;
+  const Eigen::MatrixXd A = Eigen::MatrixXd::NullaryExpr(s.dim(), s.dim(), [&] { return n(rng); });
+  s.P = A * A.transpose();
+  s.x = Eigen::VectorXd::NullaryExpr(s.dim(), [&] { return n(rng); });
+  const double dt = 0.1, sigma = 0.04, tau = 5;
+  const double phi = std::exp(-dt / tau);
+  Eigen::MatrixXd F = Eigen::MatrixXd::Identity(s.dim(), s.dim());
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(s.dim(), s.dim());
+  for (int j = 0; j < 2; ++j)
+    for (int k = 0; k < 2; ++k) {
+      F(s.gimbal(j) + k, s.gimbal(j) + k) = phi;
+      Q(s.gimbal(j) + k, s.gimbal(j) + k) = (1 - phi * phi) * sigma * sigma;
+    }
+  const Eigen::VectorXd x_dense = F * s.x;
+  const Eigen::MatrixXd P_dense = F * s.P * F.transpose() + Q;
+  for (int j = 0; j < 2; ++j) predict_gimbal_error(s, j, dt, sigma, tau);
+  EXPECT_LT((s.x - x_dense).norm(), 1e-12);
+  EXPECT_LT((s.P - P_dense).norm(), 1e-10);
+
+  for (int k = 0; k < 2000; ++k) predict_gimbal_error(s, 0, dt, sigma, tau);
+  EXPECT_NEAR(s.P(s.gimbal(0), s.gimbal(0)), sigma * sigma, 1e-6);
+  EXPECT_NEAR(s.P(s.gimbal(0), s.gimbal(0) + 1), 0.0, 1e-6);
+  EXPECT_EQ(FilterState(2).gimbal(0), -1);
+}
+
 TEST(Update, SparseUpdateEqualsDenseKalmanUpdate) {
   std::mt19937_64 rng(5);
   FilterState s = two_camera_state_with_landmarks(6, rng);
@@ -62,7 +92,7 @@ TEST(Update, SparseUpdateEqualsDenseKalmanUpdate) {
   const CameraRig rig = nadir_rig();
   std::vector<Measurement> ms;
   for (int i = 0; i < 4; ++i) {
-    auto uv = predict_landmark_pixel(s.x, s.landmarks()[i], i % 2, rig);
+    auto uv = predict_landmark_pixel(s, s.x, s.landmarks()[i], i % 2, rig);
     ASSERT_TRUE(uv);
     ms.push_back(*landmark_measurement(s, s.landmarks()[i], i % 2, rig, *uv + Eigen::Vector2d(2, -1), 3));
   }

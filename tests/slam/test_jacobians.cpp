@@ -118,19 +118,22 @@ TEST(Jacobians, RangeEq9) {
 }
 
 // The builders' block Jacobians, assembled into a dense H, against differentiation of h(x) over
-// the whole state: checks the block placement too.
-TEST(Jacobians, MeasurementBuildersPlaceTheirBlocks) {
-  FilterState s(2);
-  s.x << 0.3, -0.2, 0.1, 1, 0, 0,  //
-      -1.4, 0.1, 15.2, 1, 0, 0,      //
+// the whole state: checks the block placement too, with and without estimated gimbal errors.
+class BuilderTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
+  FilterState s(2, GetParam());
+  s.x.head<18>() << 0.3, -0.2, 0.1, 1, 0, 0,  //
+      -1.4, 0.1, 15.2, 1, 0, 0,                //
       1.6, -0.1, 16.9, 1, 0, 0;
+  if (GetParam()) s.x.segment<4>(s.gimbal(0)) << 0.03, -0.02, -0.01, 0.04;
   s.P.setIdentity();
   const CameraRig rig = tilted_rig(true);
-  s.add_landmark(LandmarkKind::Euclidean, Eigen::Vector3d(3, -2, 0.4), Eigen::MatrixXd::Zero(3, 18),
+  s.add_landmark(LandmarkKind::Euclidean, Eigen::Vector3d(3, -2, 0.4), Eigen::MatrixXd::Zero(3, s.dim()),
                  Eigen::Matrix3d::Identity());
   Vector6d y;
   y << 1.6, -0.1, 16.9, 0.1, 0.05, 0.06;
-  s.add_landmark(LandmarkKind::InverseDepth, y, Eigen::MatrixXd::Zero(6, 21),
+  s.add_landmark(LandmarkKind::InverseDepth, y, Eigen::MatrixXd::Zero(6, s.dim()),
                  Eigen::Matrix<double, 6, 6>::Identity());
 
   auto dense = [&](const Measurement& m) {
@@ -155,5 +158,65 @@ TEST(Jacobians, MeasurementBuildersPlaceTheirBlocks) {
       return builders[i](t).h;
     };
     EXPECT_LT((dense(m) - numerical_jacobian(h, s.x)).norm(), kTol) << "builder " << i;
+    // An estimated gimbal error is a state, not noise: nothing left to marginalise.
+    if (GetParam()) {
+      EXPECT_EQ(m.camera, -1) << "builder " << i;
+    }
   }
 }
+
+// eq. 52 with estimated gimbal errors: with P = I, a new landmark's cross-covariance with the
+// state is its Jacobian with respect to the state, which must match re-initialising the landmark
+// from perturbed states (camera positions and gimbal angles alike).
+TEST_P(BuilderTest, NewLandmarkCrossCovarianceIsItsStateJacobian) {
+  FilterState s(2, GetParam());
+  s.x.head<18>() << 0.3, -0.2, 0.1, 1, 0, 0,  //
+      -1.4, 0.1, 15.2, 1, 0, 0,                //
+      1.6, -0.1, 16.9, 1, 0, 0;
+  if (GetParam()) s.x.segment<4>(s.gimbal(0)) << 0.03, -0.02, -0.01, 0.04;
+  s.P.setIdentity();
+  const CameraRig rig = tilted_rig(true);
+  // Pixels of one point as the filter predicts them: rays that meet, as real matches nearly do.
+  // (Least-squares triangulation of rays that miss each other weighs them algebraically, and
+  // there a rotation and the equivalent pixel shift agree only to first order.)
+  const Eigen::Vector3d X(3, -2, 0.4);
+  const Eigen::Vector2d uv_a = *project_point(estimated_rig(s.x, s.gimbal(0), rig),
+                                              s.x.segment<3>(FilterState::cam_pos(0)), X);
+  const Eigen::Vector2d uv_b = *project_point(estimated_rig(s.x, s.gimbal(1), rig),
+                                              s.x.segment<3>(FilterState::cam_pos(1)), X);
+  const Eigen::Vector2d uv_c(420.5, 610.1);
+  CooperativeInitSettings coop;
+  coop.min_parallax_deg = 0;
+  coop.max_reprojection_px = 1e9;
+  InverseDepthInitSettings idp;
+
+  using Init = std::function<Eigen::VectorXd(FilterState&)>;
+  const std::vector<std::pair<const char*, Init>> inits = {
+      {"cooperative",
+       [&](FilterState& st) {
+         auto r = initialise_cooperative(st, 0, rig, uv_a, 1, rig, uv_b, coop);
+         EXPECT_TRUE(r.id.has_value()) << r.rejected_because;
+         return Eigen::VectorXd(st.x.tail(3));
+       }},
+      {"inverse depth",
+       [&](FilterState& st) {
+         auto r = initialise_inverse_depth(st, 1, rig, uv_c, idp);
+         EXPECT_TRUE(r.id.has_value()) << r.rejected_because;
+         return Eigen::VectorXd(st.x.tail(6));
+       }},
+  };
+  for (const auto& [name, init] : inits) {
+    FilterState t = s;
+    const Eigen::VectorXd value = init(t);
+    const int d = static_cast<int>(value.size());
+    const Eigen::MatrixXd cross = t.P.block(s.dim(), 0, d, s.dim());
+    auto f = [&](const Eigen::VectorXd& x) -> Eigen::VectorXd {
+      FilterState u = s;
+      u.x = x;
+      return init(u);
+    };
+    EXPECT_LT((cross - numerical_jacobian(f, s.x)).norm(), kTol) << name;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(WithAndWithoutGimbalStates, BuilderTest, ::testing::Bool());
