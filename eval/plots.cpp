@@ -320,4 +320,31 @@ void plot_comparison(const std::vector<std::string>& results_dirs,
   run_gnuplot(script.parent_path(), script.filename().string(), png.stem().string(), png);
 }
 
+fs::path plot_monte_carlo_nees(const std::vector<MonteCarloSummary>& summaries, const fs::path& dir) {
+  if (summaries.empty()) throw std::invalid_argument("plot_monte_carlo_nees: nothing to plot");
+  std::vector<PhaseInfo> phases;
+  for (const auto& p : summaries.front().phases)
+    if (p.name != "total") phases.push_back({p.name, p.t_start, p.t_end, ""});
+  static const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
+  std::string body = phase_marks(phases, true) +
+                     "set title 'Average NEES over Monte Carlo runs (agents'' positions and "
+                     "velocities)'\nset xlabel 't [s]'\nset ylabel 'average NEES'\nset logscale y\n"
+                     "set key top left opaque box\n";
+  std::string plot = "plot ";
+  for (std::size_t i = 0; i < summaries.size(); ++i) {
+    const auto& m = summaries[i];
+    const char* c = colours[i % 4];
+    if (i) plot += ", \\\n     ";
+    plot += fmt::format(
+        "'nees.csv' using (column('t')):(column({0})) with lines lw 1.2 lc rgb '{1}' "
+        "title {2}, \\\n     '' using (column('t')):(column({3})) with lines dt 2 lw 1.5 lc rgb "
+        "'{1}' title {4}, \\\n     '' using (column('t')):(column({5})) with lines dt 2 lw 1.5 "
+        "lc rgb '{1}' notitle",
+        gq(m.label + "_nees"), c, gq(fmt::format("{} ({} runs)", m.label, m.runs)),
+        gq(m.label + "_lower"), gq(fmt::format("{} 95% bounds [{:.1f}, {:.1f}]", m.label, m.lower, m.upper)),
+        gq(m.label + "_upper"));
+  }
+  return make_plot(dir, "montecarlo_nees", body + plot + "\n", 1100, 500);
+}
+
 }  // namespace wingman::eval

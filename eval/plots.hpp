@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "eval/montecarlo.hpp"
 #include "eval/run_record.hpp"
 
 namespace wingman::eval {
@@ -30,5 +31,11 @@ std::vector<std::filesystem::path> write_plots(const RunRecord& run,
 void plot_comparison(const std::vector<std::string>& results_dirs,
                      const std::vector<std::string>& labels, const std::string& agent,
                      const std::string& out_png);
+
+// The average NEES of Monte Carlo runs over time with its 95 % bounds and the phase
+// boundaries, every summary (e.g. multi- and single-UAV) in one plot (the paper's Fig. 11):
+// <dir>/plots/montecarlo_nees.png and .gp, reading <dir>/nees.csv (write_monte_carlo).
+std::filesystem::path plot_monte_carlo_nees(const std::vector<MonteCarloSummary>& summaries,
+                                            const std::filesystem::path& dir);
 
 }  // namespace wingman::eval

@@ -1,0 +1,262 @@
+// `wingman montecarlo`: N seeds of a scenario in parallel worker processes (each a `wingman run`
+// writing its own results directory under <out>/runs/), then the aggregate of DESIGN.md §7:
+// average NEES with its chi^2 bounds per step, the fraction of steps inside them per phase, and
+// the spread of Table 4 (eval/montecarlo). Workers are processes, not threads, so a crash or an
+// abort in one run costs that run only. Ctrl-C stops the workers and keeps the finished runs;
+// --resume skips them.
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "app/progress.hpp"
+#include "app/subcommand.hpp"
+#include "eval/montecarlo.hpp"
+#include "eval/plots.hpp"
+#include "eval/results_dir.hpp"
+#include "sim/scenario.hpp"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+
+namespace wingman::app {
+namespace {
+
+constexpr const char* kMarker = ".wingman-montecarlo";
+
+struct MonteCarloOptions {
+  std::string scenario;
+  int runs = 0;
+  int jobs = 0;
+  std::string out;
+  std::uint64_t first_seed = 1;
+  std::vector<std::string> variants;
+  bool resume = false;
+  bool no_plots = false;
+  bool quiet = false;
+};
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) { g_interrupted = true; }
+
+fs::path run_dir(const fs::path& out, std::uint64_t seed) {
+  return out / "runs" / fmt::format("seed{}", seed);
+}
+
+// The last non-empty line a failed worker wrote: its error message.
+std::string last_line(const fs::path& log) {
+  std::ifstream in(log);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  return last.empty() ? "(no output)" : last;
+}
+
+pid_t spawn_worker(const MonteCarloOptions& o, std::uint64_t seed, const fs::path& out) {
+  std::vector<std::string> args = {"wingman",  "run",   o.scenario, "--seed", std::to_string(seed),
+                                   "--out",    run_dir(out, seed).string(), "--no-plots", "-q"};
+  for (const auto& v : o.variants) args.insert(args.end(), {"--variant", v});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+
+  const std::string log = (out / "runs" / fmt::format("seed{}.log", seed)).string();
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+  // Workers ignore the terminal's Ctrl-C; the parent stops them, so none dies half-way through
+  // writing unnoticed.
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setpgroup(&attr, 0);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, "/proc/self/exe", &fa, &attr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  posix_spawnattr_destroy(&attr);
+  if (rc != 0) throw std::runtime_error(fmt::format("cannot start a worker: {}", std::strerror(rc)));
+  return pid;
+}
+
+// Variant directories of one run: <run>/<variant> when the scenario has variants.
+std::vector<std::pair<std::string, std::string>> variant_labels(const std::vector<sim::Scenario>& scns) {
+  std::vector<std::pair<std::string, std::string>> v;  // label, subdirectory ("" = the run itself)
+  const bool nested = scns.size() > 1 || !scns.front().variant.empty();
+  for (const auto& s : scns) v.emplace_back(nested ? s.variant : s.name, nested ? s.variant : "");
+  return v;
+}
+
+int montecarlo_command(const MonteCarloOptions& o) {
+  if (o.runs < 1) throw UsageError("--runs must be at least 1");
+  auto scenarios = sim::load_scenarios(o.scenario);  // bad input fails here, before any work
+  if (!o.variants.empty()) {
+    std::vector<sim::Scenario> keep;
+    for (const auto& name : o.variants) {
+      auto it = std::find_if(scenarios.begin(), scenarios.end(),
+                             [&](const sim::Scenario& s) { return s.variant == name; });
+      if (it == scenarios.end())
+        throw UsageError(fmt::format("{}: no variant '{}'", o.scenario, name));
+      keep.push_back(*it);
+    }
+    scenarios = keep;
+  }
+  if (!o.no_plots && !eval::gnuplot_available())
+    throw UsageError("gnuplot with the pngcairo terminal was not found; install it (setup.sh does) "
+                     "or pass --no-plots");
+  const fs::path out =
+      o.out.empty() ? fs::path("results") / (scenarios.front().name + "_montecarlo") : fs::path(o.out);
+  const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+
+  // The output directory: new, or one of ours (refused without --resume if it holds runs).
+  std::error_code ec;
+  if (fs::exists(out)) {
+    if (!fs::is_directory(out) || (!fs::exists(out / kMarker) && !fs::is_empty(out, ec)))
+      throw UsageError(fmt::format("{}: exists and is not a wingman Monte Carlo directory; choose "
+                                   "another --out", out.string()));
+  }
+  fs::create_directories(out / "runs");
+  std::ofstream(out / kMarker) << o.scenario << "\n";
+  // Staging directories of workers that were stopped: never complete, always safe to drop.
+  for (const auto& e : fs::directory_iterator(out / "runs"))
+    if (e.is_directory() && e.path().filename().string().find(".partial-") != std::string::npos)
+      fs::remove_all(e.path(), ec);
+
+  std::vector<std::uint64_t> pending, finished;
+  for (int i = 0; i < o.runs; ++i) {
+    const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
+    if (eval::ResultsDir::is_results_dir(run_dir(out, seed))) {
+      if (!o.resume)
+        throw UsageError(fmt::format("{}: already holds finished runs (seed {}); pass --resume to "
+                                     "keep them and run the rest, or choose another --out",
+                                     out.string(), seed));
+      finished.push_back(seed);
+    } else {
+      pending.push_back(seed);
+    }
+  }
+  if (!o.quiet && !finished.empty())
+    fmt::print(stderr, "resuming: {} of {} runs already finished\n", finished.size(), o.runs);
+
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  struct sigaction old_int {}, old_term {};
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
+
+  std::map<pid_t, std::uint64_t> running;
+  std::vector<std::pair<std::uint64_t, std::string>> failed;
+  const std::size_t to_run = pending.size();
+  std::size_t next = 0, done_now = 0;
+  ProgressLine progress("[montecarlo]", o.quiet);
+  auto status = [&] {
+    return fmt::format("runs ({} running, {} failed)", running.size(), failed.size());
+  };
+  while (!g_interrupted && (next < pending.size() || !running.empty())) {
+    while (!g_interrupted && next < pending.size() && static_cast<int>(running.size()) < jobs) {
+      const std::uint64_t seed = pending[next++];
+      running[spawn_worker(o, seed, out)] = seed;
+    }
+    progress.update(static_cast<int>(done_now), static_cast<int>(to_run), status());
+    int st = 0;
+    const pid_t pid = ::waitpid(-1, &st, 0);
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const std::uint64_t seed = it->second;
+    running.erase(it);
+    ++done_now;
+    const fs::path log = out / "runs" / fmt::format("seed{}.log", seed);
+    if (WIFEXITED(st) && WEXITSTATUS(st) == 0) {
+      finished.push_back(seed);
+    } else {
+      const std::string why = WIFEXITED(st) ? fmt::format("exit {}: {}", WEXITSTATUS(st), last_line(log))
+                                            : fmt::format("killed by signal {}", WTERMSIG(st));
+      failed.emplace_back(seed, why);
+      fmt::print(stderr, "\nrun seed {} failed ({}); log: {}\n", seed, why, log.string());
+    }
+  }
+  progress.update(static_cast<int>(done_now), static_cast<int>(to_run), status());
+  progress.finish();
+  if (g_interrupted) {
+    for (const auto& [pid, seed] : running) ::kill(pid, SIGTERM);
+    for (const auto& [pid, seed] : running) ::waitpid(pid, nullptr, 0);
+    for (const auto& e : fs::directory_iterator(out / "runs"))
+      if (e.is_directory() && e.path().filename().string().find(".partial-") != std::string::npos)
+        fs::remove_all(e.path(), ec);
+    sigaction(SIGINT, &old_int, nullptr);
+    sigaction(SIGTERM, &old_term, nullptr);
+    fmt::print(stderr, "interrupted: {} of {} runs finished and kept in {}; rerun with --resume to "
+               "run the rest\n", finished.size(), o.runs, out.string());
+    return 130;
+  }
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+
+  std::sort(finished.begin(), finished.end());
+  if (finished.empty()) {
+    fmt::print(stderr, "error: every run failed; see the logs in {}\n", (out / "runs").string());
+    return 1;
+  }
+  std::vector<eval::MonteCarloSummary> summaries;
+  for (const auto& [label, sub] : variant_labels(scenarios)) {
+    std::vector<fs::path> dirs;
+    for (auto seed : finished) dirs.push_back(sub.empty() ? run_dir(out, seed) : run_dir(out, seed) / sub);
+    summaries.push_back(eval::aggregate_runs(label, dirs));
+  }
+  eval::write_monte_carlo(summaries, out);
+  if (!o.no_plots) {
+    fs::create_directories(out / "plots");
+    eval::plot_monte_carlo_nees(summaries, out);
+  }
+  if (!o.quiet) {
+    fmt::print("Monte Carlo of {}: {} runs finished (seeds {}..{}), {} failed\n", o.scenario,
+               finished.size(), o.first_seed, o.first_seed + o.runs - 1, failed.size());
+    fmt::print("{}", eval::format_monte_carlo(summaries));
+    fmt::print("results: {}\n", out.string());
+  }
+  for (const auto& [seed, why] : failed) fmt::print(stderr, "failed: seed {}: {}\n", seed, why);
+  return failed.empty() ? 0 : 1;
+}
+
+}  // namespace
+
+Subcommand add_montecarlo(CLI::App& parent) {
+  auto o = std::make_shared<MonteCarloOptions>();
+  auto* cmd = parent.add_subcommand(
+      "montecarlo",
+      "Run N seeds of a scenario in parallel worker processes and aggregate them: average NEES "
+      "with its 95% chi2 bounds, fraction of steps inside per phase, spread of Table 4");
+  cmd->add_option("scenario", o->scenario, "Scenario YAML file")->required();
+  cmd->add_option("--runs,-n", o->runs, "Number of runs (seeds first-seed .. first-seed+N-1)")->required();
+  cmd->add_option("--jobs,-j", o->jobs, "Worker processes (default: one per core)");
+  cmd->add_option("--out,-o", o->out, "Output directory (default: results/<scenario name>_montecarlo)");
+  cmd->add_option("--first-seed", o->first_seed, "Seed of the first run (default 1)");
+  cmd->add_option("--variant", o->variants, "Run only these variants (repeatable)");
+  cmd->add_flag("--resume", o->resume, "Keep the runs already finished in --out and run the rest");
+  cmd->add_flag("--no-plots", o->no_plots, "Skip the NEES plot (no gnuplot needed)");
+  cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
+  return {cmd, [o] { return montecarlo_command(*o); }};
+}
+
+}  // namespace wingman::app

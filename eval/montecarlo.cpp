@@ -1,0 +1,240 @@
+#include "eval/montecarlo.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "geometry/chi2.hpp"
+
+namespace wingman::eval {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open", path.string()));
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw std::runtime_error(fmt::format("{}: not valid JSON: {}", path.string(), e.what()));
+  }
+}
+
+// The 't' column of steps.csv.
+std::vector<double> read_times(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open", path.string()));
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error(fmt::format("{}: empty", path.string()));
+  int col = -1, i = 0;
+  std::stringstream header(line);
+  for (std::string name; std::getline(header, name, ','); ++i)
+    if (name == "t") col = i;
+  if (col < 0) throw std::runtime_error(fmt::format("{}: no 't' column", path.string()));
+  std::vector<double> t;
+  for (int row = 2; std::getline(in, line); ++row) {
+    std::stringstream ss(line);
+    std::string cell;
+    for (int c = 0; c <= col; ++c) std::getline(ss, cell, ',');
+    try {
+      t.push_back(std::stod(cell));
+    } catch (const std::exception&) {
+      throw std::runtime_error(fmt::format("{}:{}: 't' is not a number", path.string(), row));
+    }
+  }
+  return t;
+}
+
+double number_or_nan(const json& j) { return j.is_number() ? j.get<double>() : kNaN; }
+
+}  // namespace
+
+Spread spread_of(const std::vector<double>& values) {
+  Spread s;
+  double sum = 0, sum2 = 0;
+  for (double v : values) {
+    if (!std::isfinite(v)) continue;
+    sum += v;
+    sum2 += v * v;
+    s.min = s.n == 0 ? v : std::min(s.min, v);
+    s.max = s.n == 0 ? v : std::max(s.max, v);
+    ++s.n;
+  }
+  if (s.n == 0) return s;
+  s.mean = sum / s.n;
+  s.std = s.n > 1 ? std::sqrt(std::max(0.0, (sum2 - s.n * s.mean * s.mean) / (s.n - 1))) : 0.0;
+  return s;
+}
+
+MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs::path>& run_dirs) {
+  if (run_dirs.empty()) throw std::runtime_error(fmt::format("{}: no finished runs", label));
+  MonteCarloSummary m;
+  m.label = label;
+  m.runs = static_cast<int>(run_dirs.size());
+  std::vector<json> metrics;
+  for (const auto& dir : run_dirs) metrics.push_back(read_json(dir / "metrics.json"));
+  m.t = read_times(run_dirs.front() / "steps.csv");
+  const std::size_t steps = m.t.size();
+
+  // Average NEES per step over the runs that have it (none at k = 0, before any update).
+  std::vector<double> sum(steps, 0.0);
+  std::vector<int> count(steps, 0);
+  for (std::size_t r = 0; r < metrics.size(); ++r) {
+    const auto& nees = metrics[r].at("nees");
+    const auto& per_step = nees.at("per_step");
+    if (per_step.size() != steps)
+      throw std::runtime_error(fmt::format("{}: {} NEES steps, the first run has {}",
+                                           (run_dirs[r] / "metrics.json").string(), per_step.size(),
+                                           steps));
+    const int dof = nees.at("dof").get<int>();
+    if (r == 0) m.dof = dof;
+    if (dof != m.dof)
+      throw std::runtime_error(fmt::format("{}: NEES over {} dof, the first run has {}",
+                                           (run_dirs[r] / "metrics.json").string(), dof, m.dof));
+    for (std::size_t k = 0; k < steps; ++k)
+      if (const double v = number_or_nan(per_step[k]); std::isfinite(v)) sum[k] += v, ++count[k];
+  }
+  m.average_nees.assign(steps, kNaN);
+  for (std::size_t k = 0; k < steps; ++k)
+    if (count[k] == m.runs) m.average_nees[k] = sum[k] / m.runs;
+  if (m.dof > 0) {
+    const double dn = static_cast<double>(m.dof) * m.runs;
+    m.lower = geometry::chi2_quantile(0.025, dn) / m.runs;
+    m.upper = geometry::chi2_quantile(0.975, dn) / m.runs;
+  }
+
+  // Per phase (from the first run; every run of a variant shares them) and the whole run.
+  std::vector<MonteCarloPhase> phases;
+  for (const auto& p : metrics.front().at("phases")) {
+    MonteCarloPhase ph;
+    ph.name = p.at("name").get<std::string>();
+    ph.t_start = p.at("t_start").get<double>();
+    ph.t_end = p.at("t_end").get<double>();
+    phases.push_back(ph);
+  }
+  MonteCarloPhase total;
+  total.name = "total";
+  total.t_start = m.t.empty() ? 0 : m.t.front();
+  total.t_end = m.t.empty() ? 0 : m.t.back();
+  auto bounds_count = [&](MonteCarloPhase& ph, bool whole) {
+    double nees_sum = 0;
+    for (std::size_t k = 0; k < steps; ++k) {
+      const double v = m.average_nees[k];
+      if (!std::isfinite(v)) continue;
+      const bool in_phase = whole || (m.t[k] >= ph.t_start && (m.t[k] < ph.t_end ||
+                                                                (&ph == &phases.back() && m.t[k] <= ph.t_end)));
+      if (!in_phase) continue;
+      ++ph.steps;
+      nees_sum += v;
+      if (v >= m.lower && v <= m.upper) ++ph.inside;
+    }
+    if (ph.steps > 0) {
+      ph.fraction_inside = static_cast<double>(ph.inside) / ph.steps;
+      ph.mean_nees = nees_sum / ph.steps;
+    }
+  };
+  // Table 4 spreads; `pick` finds the agents' object: table4.phases[i].agents or table4.total.
+  auto table4_spread = [&](MonteCarloPhase& ph, const json* (*pick)(const json&, std::size_t),
+                           std::size_t index) {
+    const json* first = pick(metrics.front(), index);
+    if (!first) return;
+    for (auto it = first->begin(); it != first->end(); ++it) {
+      AgentSpread a;
+      a.agent = it.key();
+      for (int axis = 0; axis < 3; ++axis) {
+        std::vector<double> v;
+        for (const auto& mj : metrics)
+          if (const json* p = pick(mj, index); p && p->contains(a.agent))
+            v.push_back(number_or_nan(p->at(a.agent).at("mse").at(axis)));
+        a.mse[axis] = spread_of(v);
+      }
+      ph.agents.push_back(a);
+    }
+  };
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    bounds_count(phases[i], false);
+    table4_spread(phases[i], [](const json& mj, std::size_t idx) -> const json* {
+      const auto& ps = mj.at("table4").at("phases");
+      return idx < ps.size() ? &ps[idx].at("agents") : nullptr;
+    }, i);
+  }
+  bounds_count(total, true);
+  table4_spread(total, [](const json& mj, std::size_t) -> const json* {
+    return &mj.at("table4").at("total");
+  }, 0);
+  phases.push_back(total);
+  m.phases = std::move(phases);
+  return m;
+}
+
+void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs::path& dir) {
+  json out = json::array();
+  for (const auto& m : summaries) {
+    json j;
+    j["label"] = m.label;
+    j["runs"] = m.runs;
+    j["nees_dof"] = m.dof;
+    j["nees_bounds"] = {m.lower, m.upper};
+    auto spread = [](const Spread& s) {
+      return json{{"mean", s.mean}, {"std", s.std}, {"min", s.min}, {"max", s.max}, {"n", s.n}};
+    };
+    for (const auto& p : m.phases) {
+      json jp{{"name", p.name},         {"t_start", p.t_start},
+              {"t_end", p.t_end},       {"nees_steps", p.steps},
+              {"nees_inside", p.inside}, {"nees_fraction_inside", p.fraction_inside},
+              {"nees_mean", p.mean_nees}};
+      for (const auto& a : p.agents)
+        jp["mse"][a.agent] = {spread(a.mse[0]), spread(a.mse[1]), spread(a.mse[2])};
+      j["phases"].push_back(jp);
+    }
+    out.push_back(j);
+  }
+  const fs::path json_path = dir / "montecarlo.json";
+  std::ofstream(json_path) << out.dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+
+  std::ofstream csv(dir / "nees.csv");
+  csv << "t";
+  for (const auto& m : summaries) csv << "," << m.label << "_nees," << m.label << "_lower," << m.label << "_upper";
+  csv << "\n";
+  const std::size_t steps = summaries.empty() ? 0 : summaries.front().t.size();
+  for (std::size_t k = 0; k < steps; ++k) {
+    csv << fmt::format("{:.6f}", summaries.front().t[k]);
+    for (const auto& m : summaries) {
+      const double v = k < m.average_nees.size() ? m.average_nees[k] : kNaN;
+      csv << "," << (std::isfinite(v) ? fmt::format("{:.6g}", v) : "NaN") << ","
+          << fmt::format("{:.6g},{:.6g}", m.lower, m.upper);
+    }
+    csv << "\n";
+  }
+  if (!csv) throw std::runtime_error(fmt::format("{}: write failed", (dir / "nees.csv").string()));
+}
+
+std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries) {
+  std::string s;
+  for (const auto& m : summaries) {
+    s += fmt::format("\n{}: {} runs, average NEES over {} dof, 95% bounds [{:.2f}, {:.2f}]\n", m.label,
+                     m.runs, m.dof, m.lower, m.upper);
+    s += fmt::format("{:<10} {:>8} {:>9}", "phase", "mean NEES", "inside");
+    const auto& agents = m.phases.front().agents;
+    for (const auto& a : agents)
+      for (const char* ax : {"X", "Y", "Z"}) s += fmt::format(" {:>15}", a.agent + " " + ax);
+    s += "\n";
+    for (const auto& p : m.phases) {
+      s += fmt::format("{:<10} {:>8.2f} {:>8.1f}%", p.name, p.mean_nees, 100 * p.fraction_inside);
+      for (const auto& a : p.agents)
+        for (const auto& sp : a.mse) s += fmt::format(" {:>7.4f}±{:<7.4f}", sp.mean, sp.std);
+      s += "\n";
+    }
+  }
+  s += "(MSE in m^2: mean ± std over the runs)\n";
+  return s;
+}
+
+}  // namespace wingman::eval

@@ -1,0 +1,58 @@
+// Aggregation of N Monte Carlo runs of one scenario variant (paper Fig. 11, DESIGN.md §7): the
+// average NEES per step with the two-sided 95 % chi^2 bounds for N runs,
+// [chi2_0.025(dof N) / N, chi2_0.975(dof N) / N], the fraction of steps inside them per phase,
+// and the mean and spread of the Table 4 metrics per phase. Reads what `wingman run` wrote.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "eval/run_record.hpp"
+
+namespace wingman::eval {
+
+struct Spread {
+  double mean = kNaN, std = kNaN, min = kNaN, max = kNaN;
+  int n = 0;
+};
+Spread spread_of(const std::vector<double>& values);
+
+struct AgentSpread {
+  std::string agent;
+  Spread mse[3];  // x, y, z over the runs
+};
+
+struct MonteCarloPhase {
+  std::string name;  // a phase, or "total"
+  double t_start = 0, t_end = 0;
+  int steps = 0;          // steps with an average NEES
+  int inside = 0;         // of which inside the bounds
+  double fraction_inside = kNaN;
+  double mean_nees = kNaN;  // average NEES averaged over the phase's steps
+  std::vector<AgentSpread> agents;  // Table 4 of the phase over the runs
+};
+
+struct MonteCarloSummary {
+  std::string label;  // the variant, or the scenario name
+  int runs = 0;
+  int dof = 0;
+  double lower = kNaN, upper = kNaN;  // bounds of the average NEES
+  std::vector<double> t, average_nees;  // per step
+  std::vector<MonteCarloPhase> phases;  // every phase, then "total"
+};
+
+// Aggregates the results directories of N runs of one variant (each holding metrics.json and
+// steps.csv). Throws std::runtime_error naming the file when one is missing or malformed, or
+// when the runs do not have the same steps.
+MonteCarloSummary aggregate_runs(const std::string& label,
+                                 const std::vector<std::filesystem::path>& run_dirs);
+
+// montecarlo.json (every summary), nees.csv (t and, per summary, average NEES and bounds).
+void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries,
+                       const std::filesystem::path& dir);
+// A readable table: per summary and phase, the fraction of steps inside the bounds and the Table
+// 4 means with their standard deviations.
+std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries);
+
+}  // namespace wingman::eval

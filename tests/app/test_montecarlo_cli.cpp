@@ -1,0 +1,82 @@
+// `wingman montecarlo` end to end on the smoke scenario: worker processes, aggregate files,
+// a failed run that does not sink the others, refusal to mix with earlier runs, and --resume.
+// GCC 12 warns falsely about std::string concatenation inlined from gtest (GCC bug 105329).
+#pragma GCC diagnostic ignored "-Wrestrict"
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "app_test_support.hpp"
+
+using namespace wingman::app::test;
+using ::testing::HasSubstr;
+
+TEST(MonteCarloCli, RunsInWorkersAggregatesAndResumes) {
+  TempDir tmp;
+  const fs::path out = tmp / "mc";
+  // Seed 2's results directory is blocked by a directory that is not ours: that run fails.
+  fs::create_directories(out / "runs" / "seed2");
+  write_file(out / "runs" / "seed2" / "keep.txt", "not a results directory");
+  write_file(out / ".wingman-montecarlo", "");
+  RunResult r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "3", "--jobs", "2", "--out",
+                             out.string(), "--no-plots", "--variant", "multi"},
+                            tmp.path());
+  EXPECT_EQ(r.exit_code, 1) << r.output;  // one run failed
+  EXPECT_THAT(r.output, HasSubstr("seed 2")) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("not a wingman results directory")) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("2 runs finished")) << r.output;
+  EXPECT_TRUE(fs::exists(out / "runs" / "seed1" / "multi" / "metrics.json"));
+  EXPECT_TRUE(fs::exists(out / "runs" / "seed3" / "multi" / "metrics.json"));
+  EXPECT_TRUE(fs::exists(out / "runs" / "seed2" / "keep.txt"));  // untouched
+
+  const auto mc = nlohmann::json::parse(read_file(out / "montecarlo.json"));
+  ASSERT_EQ(mc.size(), 1u);
+  EXPECT_EQ(mc[0]["label"], "multi");
+  EXPECT_EQ(mc[0]["runs"], 2);
+  EXPECT_EQ(mc[0]["nees_dof"], 18);
+  const double lo = mc[0]["nees_bounds"][0], hi = mc[0]["nees_bounds"][1];
+  EXPECT_LT(lo, 18);
+  EXPECT_GT(hi, 18);
+  const auto& total = mc[0]["phases"].back();
+  EXPECT_EQ(total["name"], "total");
+  EXPECT_GT(total["nees_steps"].get<int>(), 100);
+  EXPECT_GE(total["nees_fraction_inside"].get<double>(), 0.0);
+  EXPECT_TRUE(fs::exists(out / "nees.csv"));
+
+  // Without --resume the finished runs are not mixed in silently.
+  r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "3", "--out", out.string(), "--no-plots"},
+                  tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--resume")) << r.output;
+
+  // With --resume, once the blocker is gone, only seed 2 runs and all three are aggregated.
+  fs::remove_all(out / "runs" / "seed2");
+  r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "3", "--out", out.string(), "--no-plots",
+                   "--variant", "multi", "--resume"},
+                  tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("2 of 3 runs already finished")) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(read_file(out / "montecarlo.json"))[0]["runs"], 3);
+}
+
+TEST(MonteCarloCli, BadInputExits2AndWritesNothing) {
+  TempDir tmp;
+  const fs::path out = tmp / "mc";
+  RunResult r = run_wingman({"montecarlo", (tmp / "missing.yaml").string(), "--runs", "2", "--out",
+                             out.string(), "--no-plots"},
+                            tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("missing.yaml")) << r.output;
+  r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "0", "--out", out.string(), "--no-plots"},
+                  tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  // A directory that is not ours is refused.
+  fs::create_directories(out);
+  write_file(out / "thesis.tex", "");
+  r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "1", "--out", out.string(), "--no-plots"},
+                  tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(out / "runs"));
+}

@@ -1,0 +1,100 @@
+// Monte Carlo aggregation (eval/montecarlo): NEES bounds for N runs, fraction of steps inside
+// per phase, and the spread of Table 4, on results directories written here by hand.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "eval/montecarlo.hpp"
+#include "geometry/chi2.hpp"
+
+using namespace wingman::eval;
+namespace fs = std::filesystem;
+
+namespace {
+// A run of 5 steps (t = 0..0.4 s) in two phases [0, 0.2) and [0.2, 0.4], with the given NEES
+// per step (step 0 has none) and lead x MSE per phase.
+void write_run(const fs::path& dir, const std::vector<double>& nees, double mse_phase0, double mse_phase1) {
+  fs::create_directories(dir);
+  nlohmann::json m;
+  m["nees"]["dof"] = 6;
+  m["nees"]["per_step"] = nlohmann::json::array({nullptr});
+  for (double v : nees) m["nees"]["per_step"].push_back(v);
+  m["phases"] = {{{"name", "a"}, {"t_start", 0.0}, {"t_end", 0.2}},
+                 {{"name", "b"}, {"t_start", 0.2}, {"t_end", 0.4}}};
+  auto agents = [](double x) { return nlohmann::json{{"lead", {{"mse", {x, 0.0, 0.0}}}}}; };
+  m["table4"]["phases"] = {{{"agents", agents(mse_phase0)}}, {{"agents", agents(mse_phase1)}}};
+  m["table4"]["total"] = agents(0.5 * (mse_phase0 + mse_phase1));
+  std::ofstream(dir / "metrics.json") << m.dump();
+  std::ofstream csv(dir / "steps.csv");
+  csv << "k,t,nees\n";
+  for (int k = 0; k < 5; ++k) csv << k << "," << 0.1 * k << ",0\n";
+}
+
+struct TempDir {
+  fs::path path = fs::temp_directory_path() / ("wingman-mc-test-" + std::to_string(::getpid()));
+  TempDir() { fs::create_directories(path); }
+  ~TempDir() { fs::remove_all(path); }
+};
+}  // namespace
+
+TEST(MonteCarlo, SpreadOfValues) {
+  const Spread s = spread_of({1, 2, 3, 4, NAN});
+  EXPECT_EQ(s.n, 4);
+  EXPECT_DOUBLE_EQ(s.mean, 2.5);
+  EXPECT_NEAR(s.std, std::sqrt(5.0 / 3.0), 1e-12);
+  EXPECT_DOUBLE_EQ(s.min, 1);
+  EXPECT_DOUBLE_EQ(s.max, 4);
+}
+
+TEST(MonteCarlo, BoundsAverageAndFractionInsidePerPhase) {
+  TempDir tmp;
+  // Two runs; bounds for N = 2, dof 6: chi2(12) quantiles / 2 = [2.20, 11.67].
+  write_run(tmp.path / "r1", {6, 6, 30, 6}, 0.1, 0.3);
+  write_run(tmp.path / "r2", {6, 1, 30, 6}, 0.3, 0.5);
+  const MonteCarloSummary m = aggregate_runs("multi", {tmp.path / "r1", tmp.path / "r2"});
+  EXPECT_EQ(m.runs, 2);
+  EXPECT_EQ(m.dof, 6);
+  EXPECT_NEAR(m.lower, wingman::geometry::chi2_quantile(0.025, 12) / 2, 1e-12);
+  EXPECT_NEAR(m.upper, wingman::geometry::chi2_quantile(0.975, 12) / 2, 1e-12);
+  EXPECT_NEAR(m.lower, 2.2019, 1e-3);
+  ASSERT_EQ(m.average_nees.size(), 5u);
+  EXPECT_TRUE(std::isnan(m.average_nees[0]));
+  EXPECT_DOUBLE_EQ(m.average_nees[2], 3.5);
+  EXPECT_DOUBLE_EQ(m.average_nees[3], 30);
+  ASSERT_EQ(m.phases.size(), 3u);  // a, b, total
+  // Phase a: steps at t = 0.1 (6, inside); phase b: t = 0.2 (3.5, inside), 0.3 (30, outside),
+  // 0.4 (6, inside; the last phase keeps its end).
+  EXPECT_EQ(m.phases[0].steps, 1);
+  EXPECT_EQ(m.phases[0].inside, 1);
+  EXPECT_EQ(m.phases[1].steps, 3);
+  EXPECT_EQ(m.phases[1].inside, 2);
+  EXPECT_EQ(m.phases[2].name, "total");
+  EXPECT_EQ(m.phases[2].steps, 4);
+  EXPECT_NEAR(m.phases[2].fraction_inside, 0.75, 1e-12);
+  // Table 4 spread over the runs.
+  ASSERT_EQ(m.phases[0].agents.size(), 1u);
+  EXPECT_NEAR(m.phases[0].agents[0].mse[0].mean, 0.2, 1e-12);
+  EXPECT_NEAR(m.phases[1].agents[0].mse[0].max, 0.5, 1e-12);
+  EXPECT_NEAR(m.phases[2].agents[0].mse[0].mean, 0.3, 1e-12);
+}
+
+TEST(MonteCarlo, RunsWithDifferentStepsAreAnErrorNamingTheFile) {
+  TempDir tmp;
+  write_run(tmp.path / "r1", {6, 6, 6, 6}, 0.1, 0.1);
+  write_run(tmp.path / "r2", {6, 6, 6, 6}, 0.1, 0.1);
+  nlohmann::json m = nlohmann::json::parse(std::ifstream(tmp.path / "r2" / "metrics.json"));
+  m["nees"]["per_step"].push_back(1.0);
+  std::ofstream(tmp.path / "r2" / "metrics.json") << m.dump();
+  try {
+    aggregate_runs("multi", {tmp.path / "r1", tmp.path / "r2"});
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find((tmp.path / "r2" / "metrics.json").string()), std::string::npos)
+        << e.what();
+  }
+  std::ofstream(tmp.path / "r2" / "metrics.json") << "{ not json";
+  EXPECT_THROW(aggregate_runs("multi", {tmp.path / "r1", tmp.path / "r2"}), std::runtime_error);
+}
