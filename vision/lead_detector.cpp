@@ -153,18 +153,24 @@ std::optional<LeadDetection> LeadDetector::detect_marker(const cv::Mat& grey,
     return out;
   };
 
-  std::vector<Found> found = run(grey, 1.0, {0, 0});
-  if (found.empty() && predicted && cfg_.upscale > 1.0) {
+  // With a prediction: its neighbourhood first (cheap), then that neighbourhood upscaled (small
+  // markers), then the whole frame (a bad prediction).
+  std::vector<Found> found;
+  if (predicted) {
     const cv::Rect roi = cv::Rect(cvRound(predicted->x()) - cfg_.roi_half_px,
                                   cvRound(predicted->y()) - cfg_.roi_half_px, 2 * cfg_.roi_half_px + 1,
                                   2 * cfg_.roi_half_px + 1) &
                          cv::Rect(0, 0, grey.cols, grey.rows);
     if (roi.width > 8 && roi.height > 8) {
-      cv::Mat up;
-      cv::resize(grey(roi), up, cv::Size(), cfg_.upscale, cfg_.upscale, cv::INTER_CUBIC);
-      found = run(up, cfg_.upscale, cv::Point2d(roi.x, roi.y));
+      found = run(grey(roi).clone(), 1.0, cv::Point2d(roi.x, roi.y));
+      if (found.empty() && cfg_.upscale > 1.0) {
+        cv::Mat up;
+        cv::resize(grey(roi), up, cv::Size(), cfg_.upscale, cfg_.upscale, cv::INTER_CUBIC);
+        found = run(up, cfg_.upscale, cv::Point2d(roi.x, roi.y));
+      }
     }
   }
+  if (found.empty()) found = run(grey, 1.0, {0, 0});
   if (found.empty()) return std::nullopt;
 
   const auto pick = std::min_element(found.begin(), found.end(), [&](const Found& a, const Found& b) {

@@ -40,8 +40,9 @@ struct LeadDetectorSettings {
   // Corner refinement by cv::cornerSubPix with a window that scales with the marker (a fixed
   // window would reach the next corner on a 20 px marker).
   bool subpixel = true;
-  // When the full frame gives nothing and a prediction is known, the region around it is upscaled
-  // by this factor and searched again (helps markers under ~20 px). 1 disables.
+  // With a prediction, the (2 roi_half_px + 1)^2 region around it is searched first, then the
+  // same region upscaled by `upscale` (helps markers under ~20 px; 1 disables), then the whole
+  // frame. A marker cut by the region's edge is found in the whole-frame pass.
   double upscale = 2.0;
   int roi_half_px = 64;
   // Colour panel.

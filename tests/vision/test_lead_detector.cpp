@@ -77,6 +77,14 @@ TEST(LeadDetector, FindsA30PxMarkerWithin1Px) {
     EXPECT_EQ(d->source, LeadSource::Marker);
     EXPECT_NEAR(d->size_px, 30, 2);
     EXPECT_DOUBLE_EQ(d->confidence, 1.0);
+    // A prediction far off: the neighbourhood passes find nothing, the whole frame does.
+    const auto far = LeadDetector().detect(img, Vector2d(50, 400));
+    ASSERT_TRUE(far);
+    EXPECT_LT((far->uv - d->uv).norm(), 1e-6);
+    // A good prediction searches its neighbourhood and agrees with the whole-frame result.
+    const auto near = LeadDetector().detect(img, centre + Vector2d(5, 5));
+    ASSERT_TRUE(near);
+    EXPECT_LT((near->uv - centre).norm(), 1.0);
   }
 }
 
