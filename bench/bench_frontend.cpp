@@ -129,7 +129,7 @@ void BM_CrossMatch(benchmark::State& state) {
   const Features fa = fx.detect(frame_a()), fb = fx.detect(frame_b());
   std::size_t n = 0;
   for (auto _ : state) {
-    const CrossMatchResult r = match_across(fa, {}, view_a(), fb, {}, view_b());
+    const CrossMatchResult r = match_across(fa, all_keypoints(fa), view_a(), fb, all_keypoints(fb), view_b());
     n = r.matches.size();
   }
   state.counters["matches"] = static_cast<double>(n);

@@ -116,13 +116,19 @@ cv::Mat gather(const cv::Mat& desc, const std::vector<int>& idx) {
   for (int r = 0; r < out.rows; ++r) desc.row(idx[r]).copyTo(out.row(r));
   return out;
 }
-std::vector<int> all_or(const std::vector<int>& idx, int n) {
-  if (!idx.empty()) return idx;
-  std::vector<int> all(n);
+void check_indices(const std::vector<int>& idx, int n, const char* name) {
+  for (int i : idx)
+    if (i < 0 || i >= n)
+      throw std::invalid_argument(std::string("match_across: ") + name + " holds keypoint " + std::to_string(i) +
+                                  " of " + std::to_string(n));
+}
+}  // namespace
+
+std::vector<int> all_keypoints(const Features& f) {
+  std::vector<int> all(f.size());
   std::iota(all.begin(), all.end(), 0);
   return all;
 }
-}  // namespace
 
 CrossMatchResult match_across(const Features& fa, const std::vector<int>& free_a, const CameraView& a,
                               const Features& fb, const std::vector<int>& free_b, const CameraView& b,
@@ -132,8 +138,11 @@ CrossMatchResult match_across(const Features& fa, const std::vector<int>& free_a
       fa.descriptors.cols != fb.descriptors.cols)
     throw std::invalid_argument("match_across: the two cameras' descriptors are of different kinds");
   CrossMatchResult res;
-  if (fa.size() == 0 || fb.size() == 0) return res;
-  const std::vector<int> ia = all_or(free_a, fa.size()), ib = all_or(free_b, fb.size());
+  check_indices(free_a, fa.size(), "free_a");
+  check_indices(free_b, fb.size(), "free_b");
+  if (free_a.empty() || free_b.empty()) return res;
+  const std::vector<int>& ia = free_a;
+  const std::vector<int>& ib = free_b;
   const cv::Mat da = gather(fa.descriptors, ia), db = gather(fb.descriptors, ib);
   const double max_dist = cfg.max_distance > 0 ? cfg.max_distance : default_max_descriptor_distance(da);
   const auto ab = nearest_two(da, db, fa.norm), ba = nearest_two(db, da, fa.norm);

@@ -72,10 +72,13 @@ struct CrossMatchResult {
       rejected_reprojection = 0;
 };
 
-// Matches the listed keypoints of `fa` (indices free_a; empty = all) against those of `fb`.
+// Matches the listed keypoints of `fa` (indices free_a, e.g. from free_keypoints) against the
+// listed ones of `fb`; an empty list matches nothing (all_keypoints lists every one).
 CrossMatchResult match_across(const Features& fa, const std::vector<int>& free_a, const CameraView& a,
                               const Features& fb, const std::vector<int>& free_b, const CameraView& b,
                               const CrossMatchSettings& settings = {});
+
+std::vector<int> all_keypoints(const Features& f);
 
 // Landmarks a camera still needs to reach `target` in view.
 inline int landmarks_needed(int target, int in_view) { return in_view >= target ? 0 : target - in_view; }

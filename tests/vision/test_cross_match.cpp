@@ -69,7 +69,7 @@ struct TwoViews {
 
 TEST(CrossMatch, MatchesOfTwoViewsTriangulateOntoTheGroundPlane) {
   const TwoViews v;
-  const CrossMatchResult r = match_across(v.fa, {}, v.a, v.fb, {}, v.b);
+  const CrossMatchResult r = match_across(v.fa, all_keypoints(v.fa), v.a, v.fb, all_keypoints(v.fb), v.b);
   ASSERT_GE(r.matches.size(), 80u) << "descriptor matches " << r.descriptor_matches;
   // Depth precision with a 3 m baseline at 15-17 m and f = 300 px is Z^2 / (f B) ~ 0.28 m per
   // pixel of disparity error: the median point lies within 0.25 m of the plane, 90 % within 0.6 m.
@@ -113,6 +113,8 @@ TEST(CrossMatch, StillMatchesWithEstimatedPosesAndHonoursTheFreeLists) {
   const CrossMatchResult r = match_across(v.fa, free_a, a, v.fb, free_b, b);
   EXPECT_GE(r.matches.size(), 30u);
   for (const auto& m : r.matches) EXPECT_EQ(m.keypoint_a % 2, 0);
+  EXPECT_TRUE(match_across(v.fa, {}, a, v.fb, free_b, b).matches.empty());  // nothing free in a
+  EXPECT_THROW(match_across(v.fa, {v.fa.size()}, a, v.fb, free_b, b), std::invalid_argument);
   // The wrong baseline scales the triangulated depth, so check the pixels against the truth.
   const cv::Mat da = v.scene.depth(v.a), db = v.scene.depth(v.b);
   int inliers = 0;
