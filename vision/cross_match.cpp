@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
@@ -86,7 +87,7 @@ PairVerdict check_pair(const PairGeometry& g, const CrossMatchSettings& cfg) {
   if (!(g.epipolar_px <= cfg.max_epipolar_px)) return PairVerdict::Epipolar;
   if (!g.triangulated) return PairVerdict::NotTriangulated;
   if (!(g.depth_a >= cfg.min_depth && g.depth_b >= cfg.min_depth)) return PairVerdict::Depth;
-  if (g.parallax_rad * 180.0 / M_PI < cfg.min_parallax_deg) return PairVerdict::Parallax;
+  if (g.parallax_rad * 180.0 / std::numbers::pi < cfg.min_parallax_deg) return PairVerdict::Parallax;
   if (!(g.reprojection_px <= cfg.max_reprojection_px)) return PairVerdict::Reprojection;
   return PairVerdict::Accepted;
 }

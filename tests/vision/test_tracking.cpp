@@ -2,6 +2,7 @@
 // from their predicted projections and innovation covariances.
 #include <gtest/gtest.h>
 
+#include <numbers>
 #include <random>
 #include <set>
 
@@ -98,7 +99,7 @@ TEST(Tracking, LandmarksPredictedFarOutsideTheirEllipseAreNotMatchedToTheirTrueF
   const Landmarks L = make_landmarks(fa, a);
   // 40 px off in a random direction, S = 16 I: the gate (d <= 3) reaches 12 px.
   std::mt19937 rng(3);
-  std::uniform_real_distribution<double> ang(0, 2 * M_PI);
+  std::uniform_real_distribution<double> ang(0, 2 * std::numbers::pi);
   const auto preds = predict(L, b, 16 * Eigen::Matrix2d::Identity(), [&] {
     const double t = ang(rng);
     return Vector2d(40 * std::cos(t), 40 * std::sin(t));
