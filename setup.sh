@@ -16,6 +16,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libyaml-cpp-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libopencv-dev libopencv-contrib-dev
   gnuplot-nox
 )
 

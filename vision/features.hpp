@@ -1,0 +1,79 @@
+// Feature detection and description for the frontend: ORB (default), AKAZE, SIFT, or GFTT corners
+// described with ORB. Keypoints are spread over the image by grid bucketing, and image boxes (the
+// lead agent's region, which moves and must not feed the map) are kept out.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace wingman::vision {
+
+enum class DetectorKind { Orb, Akaze, Sift, GfttOrb };
+
+// "orb" | "akaze" | "sift" | "gftt_orb"; anything else throws std::invalid_argument naming it.
+DetectorKind parse_detector(std::string_view name);
+std::string to_string(DetectorKind kind);
+
+struct FeatureSettings {
+  DetectorKind kind = DetectorKind::Orb;
+  int max_features = 1000;
+  // Bucketing grid: each cell keeps at most ceil(max_features / cells) of its strongest keypoints
+  // first, then the leftover budget goes to the strongest remaining ones anywhere. 1 x 1 disables.
+  int grid_cols = 8, grid_rows = 8;
+  // The detector is asked for this many times max_features before bucketing, so that weak cells
+  // still have candidates.
+  double oversample = 2.0;
+  int orb_fast_threshold = 12;   // lower than OpenCV's 20: rendered ground is often low-contrast
+  int orb_levels = 4;            // pyramid levels (scale changes between UAVs are small)
+  float orb_scale_factor = 1.2f;
+  double akaze_threshold = 0.0005;
+  double gftt_quality = 0.005, gftt_min_distance = 5.0;
+  double sift_contrast = 0.02;
+
+  void validate() const;  // throws std::invalid_argument naming the bad value
+};
+
+// An axis-aligned pixel box kept free of features, e.g. around the lead's detected or predicted
+// pixel. Boxes are clipped to the image.
+struct ExclusionBox {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  double half_width = 0, half_height = 0;
+  bool contains(const Eigen::Vector2d& uv) const;
+};
+
+// Keypoints of one image and one descriptor row per keypoint.
+struct Features {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;                 // CV_8U (binary, Hamming) or CV_32F (SIFT, L2)
+  int norm = cv::NORM_HAMMING;         // cv::NORM_HAMMING or cv::NORM_L2
+  int size() const { return static_cast<int>(keypoints.size()); }
+  Eigen::Vector2d pixel(int i) const { return {keypoints[i].pt.x, keypoints[i].pt.y}; }
+};
+
+class FeatureExtractor {
+ public:
+  explicit FeatureExtractor(const FeatureSettings& settings = {});
+  const FeatureSettings& settings() const { return cfg_; }
+  // Detects and describes; colour images are converted to grey. OpenCV's keypoint coordinates
+  // follow DESIGN.md §2 (pixel (0,0) is the centre of the top-left pixel).
+  Features detect(const cv::Mat& image, const std::vector<ExclusionBox>& exclude = {}) const;
+  int norm() const;
+
+ private:
+  FeatureSettings cfg_;
+  cv::Ptr<cv::Feature2D> detector_, describer_;
+};
+
+// Keeps at most `budget` keypoints: per grid cell the strongest first, then the strongest left.
+std::vector<cv::KeyPoint> bucket_keypoints(const std::vector<cv::KeyPoint>& keypoints, int width,
+                                           int height, int grid_cols, int grid_rows, int budget);
+
+// Default acceptance threshold on descriptor distance for a descriptor type: a quarter of the bits
+// for binary descriptors (64 of ORB's 256), 250 for SIFT (descriptors have norm about 512).
+double default_max_descriptor_distance(const cv::Mat& descriptors);
+
+}  // namespace wingman::vision
