@@ -28,6 +28,7 @@ void FormationController::reset() {
   integral_.setZero();
   frozen_.setZero();
   held_yaw_.reset();
+  last_velocity_.reset();
 }
 
 double FormationController::switching(Switching kind, double s, double phi) {
@@ -97,6 +98,18 @@ ControllerOutput FormationController::update(const ControllerInput& in, double d
   const double vz = std::clamp(cmd.vz, -cfg_.max_vertical_speed, cfg_.max_vertical_speed);
   if (vz != cmd.vz) frozen_(2) = 1;
   cmd.vz = vz;
+  if (cfg_.max_acceleration > 0) {
+    const Eigen::Vector3d prev = last_velocity_.value_or(Eigen::Vector3d::Zero());
+    const Eigen::Vector3d v(cmd.vx, cmd.vy, cmd.vz);
+    const double dv_max = cfg_.max_acceleration * std::max(dt, 0.0);
+    if ((v - prev).norm() > dv_max) {
+      const Eigen::Vector3d lim = prev + (v - prev) * (dv_max / (v - prev).norm());
+      cmd.vx = lim.x();
+      cmd.vy = lim.y();
+      cmd.vz = lim.z();  // a rate limit, not a saturation: the integral keeps running
+    }
+  }
+  last_velocity_ = Eigen::Vector3d(cmd.vx, cmd.vy, cmd.vz);
   out.command = cmd;
   out.limited = frozen_.any();
   return out;

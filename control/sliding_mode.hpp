@@ -30,6 +30,10 @@ struct SlidingModeSettings {
   double max_horizontal_speed = 5.0;                   // |(vx, vy)|, m/s
   double max_vertical_speed = 2.0;                     // |vz|, m/s
   double max_yaw_rate = 0.5;                           // |w|, rad/s
+  // Largest change of (vx, vy, vz) from one command to the next, per second: a vehicle cannot
+  // jump in velocity, and the estimator's constant-velocity model (eq. 33-34) cannot follow one.
+  // 0 turns it off.
+  double max_acceleration = 1.0;  // m/s^2
   // Freeze the integral of a component whose command hit a limit, so a long saturation does
   // not wind it up.
   bool anti_windup = true;
@@ -69,7 +73,8 @@ class FormationController {
                       Eigen::Vector3d camera_offset = Eigen::Vector3d::Zero());
 
   // One control step: dt is the time since the previous update (0 on the first), over which
-  // the integral of eq. 60 accumulates the current error.
+  // the integral of eq. 60 accumulates the current error and the acceleration limit applies
+  // (the first command starts from rest).
   ControllerOutput update(const ControllerInput& in, double dt);
   void reset();
 
@@ -88,6 +93,7 @@ class FormationController {
   Eigen::Vector4d integral_ = Eigen::Vector4d::Zero();
   std::optional<double> held_yaw_;
   Eigen::Vector4d frozen_ = Eigen::Vector4d::Zero();  // 1 where the last command was clipped
+  std::optional<Eigen::Vector3d> last_velocity_;       // (vx, vy, vz) of the last command
 };
 
 }  // namespace wingman::control

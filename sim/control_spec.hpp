@@ -30,6 +30,7 @@ struct ControlSpec {
   SwitchingSpec switching = SwitchingSpec::Saturation;
   Eigen::Vector4d boundary_width{1.0, 1.0, 1.0, 0.3};
   double max_horizontal_speed = 5.0, max_vertical_speed = 2.0, max_yaw_rate = 0.5;
+  double max_acceleration = 1.0;  // m/s^2, change of (vx, vy, vz) between commands; 0: none
   bool anti_windup = true;
   double lead_bearing_min_range = 5.0;
   // Delta_g of eq. 58, added to u = [-vx, -vy, vz, w] of every UAV: each component a sum of two

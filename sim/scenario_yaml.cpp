@@ -689,10 +689,11 @@ void parse_control(const Ctx& ctx, const Field& f, ControlSpec& c, const std::ve
   }
   set_if(m, "boundary_width", c.boundary_width, [&](const Field& x) { return read_vec4(ctx, x, gt(0)); });
   if (auto lf = m.get("limits")) {
-    MapView l(ctx, *lf, {"horizontal_speed", "vertical_speed", "yaw_rate"});
+    MapView l(ctx, *lf, {"horizontal_speed", "vertical_speed", "yaw_rate", "acceleration"});
     num(ctx, l, "horizontal_speed", c.max_horizontal_speed, gt(0));
     num(ctx, l, "vertical_speed", c.max_vertical_speed, gt(0));
     num(ctx, l, "yaw_rate", c.max_yaw_rate, gt(0));
+    num(ctx, l, "acceleration", c.max_acceleration, ge(0));
   }
   boolean(ctx, m, "anti_windup", c.anti_windup);
   num(ctx, m, "lead_bearing_min_range", c.lead_bearing_min_range, ge(0));
@@ -786,6 +787,9 @@ void finalise(const Ctx& ctx, Scenario& s, const Provenance& prov) {
                                     "UAVs, got {}; add a UAV or set estimator.mode: single",
                                     s.uavs.size()));
   }
+  if (s.closed_loop() && e.mode == EstimatorMode::SingleUav)
+    ctx.fail(prov.mode, "closed loop (the control: section) needs mode multi: the controller of "
+                        "every UAV takes its position from the estimator");
   if (e.target_landmarks_per_camera > e.max_landmarks) {
     if (prov.target_per_camera.valid())
       ctx.fail(prov.target_per_camera, fmt::format("must not exceed max_landmarks ({}), got {}",
