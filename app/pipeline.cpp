@@ -1,11 +1,16 @@
 #include "app/pipeline.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <map>
 #include <stdexcept>
 
 #include "app/version.hpp"
+#include "control/formation.hpp"
+#include "control/sliding_mode.hpp"
+#include "sim/closed_loop_truth.hpp"
 #include "sim/synthetic_source.hpp"
 #include "sim/truth.hpp"
 #include "slam/estimator.hpp"
@@ -57,14 +62,18 @@ double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
   return e.dot(ldlt.solve(e));
 }
 
-}  // namespace
+// What a closed loop adds to the open-loop step: bring the truth to t before anything is
+// measured, and compute the commands from the updated estimate (filling the step's record).
+struct LoopHooks {
+  std::function<void(int k, double t)> advance;
+  std::function<void(int k, double t, const slam::Estimator&, eval::StepRecord&)> control;
+};
 
-eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress,
-                              const StateObserver& observer) {
+eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
+                         sim::SyntheticSource& source, const ProgressFn& progress,
+                         const StateObserver& observer, const LoopHooks& hooks) {
   const auto wall0 = Clock::now();
   const bool single = scn.estimator.mode == sim::EstimatorMode::SingleUav;
-  const sim::OpenLoopTruth truth(scn);
-  sim::SyntheticSource source(scn, truth);
 
   // Cameras in the filter, by UAV index: every UAV (multi) or only the baseline's (single).
   std::vector<int> cam_uav;
@@ -153,11 +162,13 @@ eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progre
   };
 
   record_step(0, 0.0, 0, 0, 0, 0, 0, 0, 0);
+  if (hooks.control) hooks.control(0, 0.0, est, rec.steps.back());
   const int N = scn.num_steps();
   const double dt = scn.dt();
   for (int k = 1; k <= N; ++k) {
     const double t = k * dt;
     const int phase = scn.phase_at(t);
+    if (hooks.advance) hooks.advance(k, t);
 
     auto t0 = Clock::now();
     est.predict(dt);
@@ -274,11 +285,127 @@ eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progre
 
     record_step(k, t, visible, static_cast<int>(cands.size()), accepted, initialised, t_predict,
                 t_update, t_init);
+    if (hooks.control) hooks.control(k, t, est, rec.steps.back());
     if (observer) observer(k, est.state());
     if (progress) progress(k, N);
   }
   rec.wall_time_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   return rec;
+}
+
+control::SlidingModeSettings controller_settings(const sim::ControlSpec& c) {
+  control::SlidingModeSettings s;
+  s.k1 = c.k1;
+  s.k2 = c.k2;
+  switch (c.switching) {
+    case sim::SwitchingSpec::Sign: s.switching = control::Switching::Sign; break;
+    case sim::SwitchingSpec::Saturation: s.switching = control::Switching::Saturation; break;
+    case sim::SwitchingSpec::Tanh: s.switching = control::Switching::Tanh; break;
+  }
+  s.boundary_width = c.boundary_width;
+  s.max_horizontal_speed = c.max_horizontal_speed;
+  s.max_vertical_speed = c.max_vertical_speed;
+  s.max_yaw_rate = c.max_yaw_rate;
+  s.max_acceleration = c.max_acceleration;
+  s.anti_windup = c.anti_windup;
+  s.lead_bearing_min_range = c.lead_bearing_min_range;
+  return s;
+}
+
+// Section 7.3: the estimator's positions and the AHRS yaw feed one sliding-mode controller per
+// UAV; its command, plus Delta_g (eq. 58), drives eq. 53 until the next step (ZOH, Fig. 7).
+eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& progress,
+                                const StateObserver& observer) {
+  if (scn.estimator.mode != sim::EstimatorMode::MultiUav)
+    throw std::invalid_argument("closed loop needs the multi-UAV estimator");
+  sim::ClosedLoopTruth truth(scn);
+  sim::SyntheticSource source(scn, truth);
+  const int n = static_cast<int>(scn.uavs.size());
+  const sim::InputDisturbance disturbance(scn.control.disturbance_bound, n,
+                                          scn.control.disturbance_seed.value_or(scn.seed));
+  std::vector<control::FormationController> ctrl;
+  std::vector<control::UavPose> pose;
+  for (int j = 0; j < n; ++j) {
+    const auto& name = scn.uavs[j].name;
+    const auto it = std::find_if(scn.control.uavs.begin(), scn.control.uavs.end(),
+                                 [&](const sim::UavControlSpec& c) { return c.uav == name; });
+    if (it == scn.control.uavs.end()) throw std::invalid_argument("no control entry for " + name);
+    ctrl.emplace_back(control::DesiredFormation{it->lambda_d, it->yaw_d},
+                      controller_settings(scn.control), scn.uavs[j].camera.offset);
+    pose.push_back({scn.uavs[j].initial_position, it->initial_yaw});
+  }
+  std::vector<control::BodyVelocity> cmd(n);
+  const double dt = scn.dt();
+  constexpr int kSubsteps = 10;  // Delta_g varies within a step; the command does not (ZOH)
+
+  LoopHooks hooks;
+  hooks.advance = [&](int, double t) {
+    const double h = dt / kSubsteps;
+    for (int j = 0; j < n; ++j) {
+      control::UavPose q = pose[j];
+      const double t0 = t - dt;
+      for (int i = 0; i < kSubsteps; ++i) {
+        const Eigen::Vector4d u = control::input_vector(cmd[j]) + disturbance(j, t0 + (i + 0.5) * h);
+        q = control::propagate(q, control::body_velocity(u), h);
+      }
+      const Eigen::Vector3d v = (q.position - pose[j].position) / dt;
+      pose[j] = q;
+      truth.set_uav(j, q.position, v, q.yaw);
+    }
+    truth.set_time(t);
+  };
+  hooks.control = [&](int k, double t, const slam::Estimator& est, eval::StepRecord& st) {
+    const auto lead = truth.lead(t);
+    for (int j = 0; j < n; ++j) {
+      control::ControllerInput in;
+      in.lead_position = est.lead_position();
+      in.lead_velocity = est.lead_velocity();
+      in.camera_position = est.camera_position(j);
+      in.yaw = source.ahrs_yaw(j, t);
+      const auto out = ctrl[j].update(in, k == 0 ? 0.0 : dt);
+      cmd[j] = out.command;
+      eval::FormationStep f;
+      f.position_true = pose[j].position;
+      f.yaw_true = pose[j].yaw;
+      f.yaw_ahrs = in.yaw;
+      f.lambda_est = out.lambda;
+      f.lambda_d_est = out.lambda_d;
+      f.surface = out.surface;
+      f.command = {cmd[j].vx, cmd[j].vy, cmd[j].vz, cmd[j].omega};
+      f.limited = out.limited;
+      f.lambda_true = control::formation_variables(lead.position, pose[j]);
+      // The formation the truth asked for: the same lambda_d with psi_d from the true lead
+      // (the controller's held psi_d while the bearing is undefined near the origin).
+      f.lambda_d_true = out.lambda_d;
+      const auto& d = ctrl[j].desired();
+      if (d.yaw)
+        f.lambda_d_true(3) = *d.yaw;
+      else if (lead.position.head<2>().norm() >= scn.control.lead_bearing_min_range)
+        f.lambda_d_true(3) = control::FormationController::lead_bearing(lead.position, lead.velocity)(0);
+      st.formation.push_back(f);
+    }
+  };
+
+  eval::RunRecord rec = run_loop(scn, truth, source, progress, observer, hooks);
+  rec.closed_loop = true;
+  for (const auto& u : scn.uavs) rec.formation_uavs.push_back(u.name);
+  rec.settling_time = scn.control.settling_time;
+  return rec;
+}
+
+eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progress,
+                              const StateObserver& observer) {
+  const sim::OpenLoopTruth truth(scn);
+  sim::SyntheticSource source(scn, truth);
+  return run_loop(scn, truth, source, progress, observer, {});
+}
+
+}  // namespace
+
+eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress,
+                              const StateObserver& observer) {
+  return scn.closed_loop() ? run_closed_loop(scn, progress, observer)
+                           : run_open_loop(scn, progress, observer);
 }
 
 }  // namespace wingman::app

@@ -1,6 +1,7 @@
-// The open-loop pipeline on synthetic measurements: truth -> synthetic source -> estimator, one
-// step at a time, with the bookkeeping evaluation needs (truth of every landmark the filter
-// initialises, outliers injected and accepted, per-stage timings). Only app/ wires sim and slam.
+// The pipeline on synthetic measurements: truth -> synthetic source -> estimator, and in closed
+// loop -> controller -> truth, one step at a time, with the bookkeeping evaluation needs (truth
+// of every landmark the filter initialises, outliers injected and accepted, per-stage timings).
+// Only app/ wires sim, slam and control.
 #pragma once
 
 #include <functional>
@@ -17,6 +18,8 @@ using ProgressFn = std::function<void(int, int)>;
 // Called after each step with the filter state, for invariant checks (tests) and inspection.
 using StateObserver = std::function<void(int, const slam::FilterState&)>;
 
+// Open loop (truth known in advance), or closed loop when the scenario has a control: section:
+// then the UAVs fly the sliding-mode controller's commands computed from the estimates (section 6).
 eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress = {},
                               const StateObserver& observer = {});
 

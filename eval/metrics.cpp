@@ -167,6 +167,7 @@ Metrics compute_metrics(const RunRecord& run) {
   m.timings_ms.init = summarise(std::move(t_init));
   m.timings_ms.total = summarise(std::move(t_total));
   m.landmarks.initialised = static_cast<long>(run.landmarks.size());
+  m.formation = compute_formation_metrics(run);
   return m;
 }
 

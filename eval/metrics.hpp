@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "eval/formation.hpp"
 #include "eval/run_record.hpp"
 
 namespace wingman::eval {
@@ -75,6 +76,7 @@ struct Metrics {
   NeesMetrics nees;
   Timings timings_ms;
   LandmarkCounts landmarks;
+  FormationMetrics formation;  // closed loop only (formation.hpp)
 };
 
 // Throws std::invalid_argument if a step's agent count differs from agent_names or a step

@@ -204,6 +204,81 @@ std::string nees_body(const RunRecord& run, int dof) {
   return s + plot + "\n";
 }
 
+// Closed loop, Fig. 13: top view of the lead and the UAVs, truth and estimate.
+std::string top_view_body(const RunRecord& run) {
+  const char* colours[] = {"black", "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e"};
+  std::string s =
+      "set title 'closed loop: trajectories seen from above (truth solid, estimate dashed)'\n"
+      "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset size ratio -1\nset offsets 0, 0, 0, 0\n"
+      "set autoscale\nset key outside right top box\nplot ";
+  for (std::size_t a = 0; a < run.agent_names.size(); ++a) {
+    const std::string& n = run.agent_names[a];
+    const char* c = colours[a % std::size(colours)];
+    s += fmt::format(
+        "{}'steps.csv' using ({}):({}) with lines lw 2 lc rgb '{}' title {}, \\\n"
+        "     '' using ({}):({}) with lines lw 1 dt 2 lc rgb '{}' title {}",
+        a == 0 ? "" : ", \\\n     ", col(n + "_px_true"), col(n + "_py_true"), c,
+        gq(n + " truth"), col(n + "_px_est"), col(n + "_py_est"), c, gq(n + " estimate"));
+  }
+  return s + "\n";
+}
+
+// Closed loop, Fig. 14: lambda - lambda_d per component over time, true and as the controller
+// saw it, with the settling window shaded out.
+std::string formation_errors_body(const RunRecord& run) {
+  const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
+  const char* comp[4] = {"lx", "ly", "lz", "psi"};
+  const char* label[4] = {"e lambda_x [m]", "e lambda_y [m]", "e lambda_z [m]", "e psi [rad]"};
+  std::string s = fmt::format(
+      "set multiplot layout 4,1 title {}\nset lmargin 10\nset rmargin 3\n"
+      "set key top right opaque box\n",
+      gq(fmt::format("closed loop: formation error lambda - lambda_d (truth solid, controller's "
+                     "view thin); metrics start {:g} s into each phase",
+                     run.settling_time)));
+  for (int i = 0; i < 4; ++i) {
+    s += phase_marks(run.phases, i == 0);
+    s += fmt::format("set ylabel {}\n", gq(label[i]));
+    s += i == 3 ? "set xlabel 't [s]'\n" : "unset xlabel\n";
+    if (i == 1) s += "unset key\n";
+    s += "plot ";
+    for (std::size_t u = 0; u < run.formation_uavs.size(); ++u) {
+      const std::string& n = run.formation_uavs[u];
+      const char* c = colours[u % std::size(colours)];
+      s += fmt::format(
+          "{}'formation.csv' using (column('t')):({}) with lines lw 1.5 lc rgb '{}' title {}, \\\n"
+          "     '' using (column('t')):({}) with lines lw 0.5 lc rgb '{}' title {}",
+          u == 0 ? "" : ", \\\n     ", col(fmt::format("{}_e_{}_true", n, comp[i])), c,
+          gq(n + " truth"), col(fmt::format("{}_e_{}_est", n, comp[i])), c,
+          gq(n + " controller"));
+    }
+    s += "\n";
+  }
+  return s + "unset multiplot\n";
+}
+
+// Closed loop, Fig. 15: norm of the position error of the lead and of each UAV over time.
+std::string closed_loop_errors_body(const RunRecord& run) {
+  std::string s = fmt::format(
+      "set multiplot layout {},1 title 'closed loop: position estimation error'\n"
+      "set lmargin 10\nset rmargin 3\nset key top right opaque box\nset yrange [0:*]\n",
+      run.agent_names.size());
+  for (std::size_t a = 0; a < run.agent_names.size(); ++a) {
+    const std::string& n = run.agent_names[a];
+    s += phase_marks(run.phases, a == 0);
+    s += fmt::format("set ylabel {}\n", gq("|e " + n + "| [m]"));
+    s += a + 1 == run.agent_names.size() ? "set xlabel 't [s]'\n" : "unset xlabel\n";
+    std::string norm;
+    for (const char* ax : kAxes) {
+      const std::string p = fmt::format("{}_p{}", n, ax);
+      norm += fmt::format("{}({} - {})**2", norm.empty() ? "" : " + ", col(p + "_est"), col(p + "_true"));
+    }
+    s += fmt::format("plot 'steps.csv' using (column('t')):(sqrt({})) with lines lw 1.5 lc rgb '{}' "
+                     "title {}\n",
+                     norm, kErrColour, gq(n));
+  }
+  return s + "unset multiplot\n";
+}
+
 std::vector<std::string> csv_header(const fs::path& csv) {
   std::ifstream in(csv);
   std::string line;
@@ -262,6 +337,15 @@ std::vector<fs::path> write_plots(const RunRecord& run, const fs::path& results_
     if (dof == 0) dof = s.nees_dof;
   }
   if (any_nees) pngs.push_back(make_plot(results_dir, "nees", nees_body(run, dof), 1200, 500));
+  if (run.closed_loop) {
+    if (!fs::is_regular_file(results_dir / "formation.csv")) {
+      throw std::runtime_error("cannot draw the formation plots: " +
+                               (results_dir / "formation.csv").string() + " does not exist");
+    }
+    pngs.push_back(make_plot(results_dir, "closed_loop_trajectories", top_view_body(run), 1300, 600));
+    pngs.push_back(make_plot(results_dir, "formation_errors", formation_errors_body(run), 1200, 1100));
+    pngs.push_back(make_plot(results_dir, "closed_loop_errors", closed_loop_errors_body(run), 1200, 900));
+  }
   return pngs;
 }
 

@@ -18,6 +18,8 @@ bool gnuplot_available();
 // Writes into <results_dir>/plots/: trajectory_<agent>.png (truth and estimate per axis,
 // Fig. 9), errors_<agent>.png (|error| per axis with 3 sigma, Fig. 10), landmarks.png and
 // nees.png (left out when the run has no finite NEES), each with its .gp script.
+// Closed-loop runs add closed_loop_trajectories.png (top view, Fig. 13), formation_errors.png
+// (Fig. 14, from formation.csv) and closed_loop_errors.png (error norms, Fig. 15).
 // results_dir must already hold steps.csv (write_steps_csv). Returns the PNGs written.
 // Throws std::runtime_error naming the plot if gnuplot is missing or fails.
 std::vector<std::filesystem::path> write_plots(const RunRecord& run,

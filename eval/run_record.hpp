@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -19,6 +20,22 @@ struct AgentStep {
   Eigen::Vector3d p_sigma = Eigen::Vector3d::Zero();  // sqrt of diag of the position covariance
 };
 
+// Closed loop only (paper section 6): one UAV's formation at one step. "true" values come from
+// the truth (lead, body position, yaw; psi_d from the true lead's bearing), "est" ones are what
+// the controller computed from the estimator and the AHRS.
+struct FormationStep {
+  Eigen::Vector3d position_true = Eigen::Vector3d::Zero();  // body, for inter-UAV distances
+  Eigen::Vector4d lambda_true = Eigen::Vector4d::Zero(), lambda_d_true = Eigen::Vector4d::Zero();
+  Eigen::Vector4d lambda_est = Eigen::Vector4d::Zero(), lambda_d_est = Eigen::Vector4d::Zero();
+  Eigen::Vector4d surface = Eigen::Vector4d::Zero();  // s of eq. 60
+  Eigen::Vector4d command = Eigen::Vector4d::Zero();  // vx, vy, vz, w commanded (after limits)
+  double yaw_true = 0, yaw_ahrs = 0;
+  bool limited = false;
+  // lambda - lambda_d with psi wrapped to (-pi, pi].
+  Eigen::Vector4d error_true() const;
+  Eigen::Vector4d error_est() const;
+};
+
 struct StepRecord {
   int k = 0;
   double t = 0;
@@ -32,6 +49,7 @@ struct StepRecord {
   int matches_accepted = 0;
   int initialised = 0;            // landmarks added this step
   double t_predict_ms = 0, t_update_ms = 0, t_init_ms = 0;
+  std::vector<FormationStep> formation;  // closed loop: per RunRecord::formation_uavs; else empty
 };
 
 struct LandmarkRecord {
@@ -76,6 +94,23 @@ struct RunRecord {
   std::vector<LandmarkRecord> landmarks;
   std::vector<OutlierCounts> outliers;
   double wall_time_s = 0;
+  // Closed loop (section 6): the controlled UAVs and when formation metrics start in a phase.
+  bool closed_loop = false;
+  std::vector<std::string> formation_uavs;
+  double settling_time = 10.0;
 };
+
+inline Eigen::Vector4d wrapped_difference(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
+  Eigen::Vector4d e = a - b;
+  e(3) = std::remainder(e(3), 2 * M_PI);
+  if (e(3) <= -M_PI) e(3) += 2 * M_PI;
+  return e;
+}
+inline Eigen::Vector4d FormationStep::error_true() const {
+  return wrapped_difference(lambda_true, lambda_d_true);
+}
+inline Eigen::Vector4d FormationStep::error_est() const {
+  return wrapped_difference(lambda_est, lambda_d_est);
+}
 
 }  // namespace wingman::eval

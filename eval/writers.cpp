@@ -128,6 +128,31 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
   j["landmarks"] = {{"initialised", m.landmarks.initialised},
                     {"max_in_state", m.landmarks.max_in_state},
                     {"count_per_step", m.landmarks.count_per_step}};
+  if (m.formation.present) {
+    const FormationMetrics& f = m.formation;
+    auto v4 = [](const Eigen::Vector4d& v) {
+      return json::array({num(v(0)), num(v(1)), num(v(2)), num(v(3))});
+    };
+    auto errs = [&](const std::vector<FormationError>& e) {
+      json o = json::object();
+      for (std::size_t u = 0; u < e.size() && u < run.formation_uavs.size(); ++u)
+        o[run.formation_uavs[u]] = {{"rms", v4(e[u].rms)}, {"max_abs", v4(e[u].max_abs)},
+                                    {"steps", e[u].steps}};
+      return o;
+    };
+    json fp = json::array();
+    for (const FormationPhase& p : f.phases)
+      fp.push_back({{"phase", p.phase}, {"name", phase_name(run, p.phase)}, {"t_from", num(p.t_from)},
+                    {"truth", errs(p.truth)}, {"controller", errs(p.controller)},
+                    {"min_inter_uav_distance", num(p.min_inter_uav_distance)}});
+    j["formation"] = {{"components", {"lambda_x", "lambda_y", "lambda_z", "psi"}},
+                      {"settling_time", num(f.settling_time)},
+                      {"phases", fp},
+                      {"total", {{"truth", errs(f.total_truth)}, {"controller", errs(f.total_controller)}}},
+                      {"min_inter_uav_distance", num(f.min_inter_uav_distance)},
+                      {"limited_fraction", num(f.limited_fraction)}};
+  }
+  j["closed_loop"] = run.closed_loop;
   j["wall_time_s"] = num(run.wall_time_s);
   j["steps"] = run.steps.size();
   write_file(path, j.dump(2) + "\n");
@@ -244,6 +269,7 @@ void write_results(const Metrics& metrics, const RunRecord& run, const fs::path&
   write_landmarks_csv(run, dir / "landmarks.csv");
   write_map_ply(run, dir / "map.ply", MapPoints::estimate);
   write_map_ply(run, dir / "map_truth.ply", MapPoints::truth);
+  write_formation_csv(run, dir / "formation.csv");
 }
 
 std::string format_summary(const Metrics& m, const RunRecord& run) {
@@ -340,6 +366,7 @@ std::string format_summary(const Metrics& m, const RunRecord& run) {
                  cell(t.total.max, 0, 3));
   fmt::format_to(out, "Landmarks: {} initialised, at most {} in the state\n",
                  m.landmarks.initialised, m.landmarks.max_in_state);
+  fmt::format_to(out, "{}", format_formation_summary(m.formation, run));
   return fmt::to_string(b);
 }
 

@@ -32,11 +32,12 @@ enum class MapPoints { estimate, truth };
 void write_map_ply(const RunRecord& run, const std::filesystem::path& path, MapPoints which);
 
 // Everything above into a results directory: metrics.json, traj/, steps.csv, landmarks.csv,
-// map.ply, map_truth.ply. Plots are separate (plots.hpp) because they need gnuplot.
+// map.ply, map_truth.ply, and formation.csv in closed loop. Plots are separate (plots.hpp) because they need gnuplot.
 void write_results(const Metrics& metrics, const RunRecord& run,
                    const std::filesystem::path& dir);
 
-// Readable fixed-width tables (Table 4, 5, 3, NEES, timings, map size) for stdout.
+// Readable fixed-width tables (Table 4, 5, 3, NEES, timings, map size, and the formation errors
+// in closed loop) for stdout.
 std::string format_summary(const Metrics& metrics, const RunRecord& run);
 
 }  // namespace wingman::eval

@@ -163,3 +163,22 @@ int Scenario::uav_index(const std::string& name) const {
 }
 
 }  // namespace wingman::sim
+
+namespace wingman::sim {
+
+const char* to_string(SwitchingSpec s) {
+  switch (s) {
+    case SwitchingSpec::Sign: return "sign";
+    case SwitchingSpec::Saturation: return "sat";
+    case SwitchingSpec::Tanh: return "tanh";
+  }
+  return "?";
+}
+
+std::vector<UavControlSpec> paper_control_uavs() {
+  UavControlSpec u1{"uav1", 1.0, {2.5, 1, 14}, std::nullopt};
+  UavControlSpec u2{"uav2", 0.5, {0.5, -1, 16}, std::nullopt};
+  return {u1, u2};
+}
+
+}  // namespace wingman::sim

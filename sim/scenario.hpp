@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geometry/camera.hpp"
+#include "sim/control_spec.hpp"
 
 namespace wingman::sim {
 
@@ -156,6 +157,7 @@ struct Scenario {
   std::vector<Phase> phases;
   std::vector<Outage> outages;
   EstimatorSpec estimator{};
+  ControlSpec control{};  // enabled: closed loop (section 6)
 
   double dt() const { return 1.0 / rate; }
   int num_steps() const;  // steps after t = 0
@@ -164,6 +166,7 @@ struct Scenario {
   // Whether a sensor kind is fed at time t for an agent ("lead" or a UAV name).
   bool sensor_active(Sensor s, double t, const std::string& agent) const;
   int uav_index(const std::string& name) const;  // -1 when absent
+  bool closed_loop() const { return control.enabled; }
 };
 
 // A malformed scenario: the message names file:line and the key.

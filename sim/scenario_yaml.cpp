@@ -616,9 +616,115 @@ void parse_estimator(const Ctx& ctx, const Field& f, EstimatorSpec& e, Provenanc
   }
 }
 
+// ---- control: (closed loop, paper section 6 and 7.3) ----------------------------------------
+
+// A number for all four components of lambda = [lx, ly, lz, psi], or a list of four.
+Eigen::Vector4d read_vec4(const Ctx& ctx, const Field& f, Bounds b) {
+  if (f.node.IsScalar()) return Eigen::Vector4d::Constant(read_number(ctx, f, b));
+  if (!f.node.IsSequence() || f.node.size() != 4) {
+    ctx.fail(f.loc(), fmt::format("expected a number or a list of 4 numbers (x, y, z, yaw), got {}",
+                                  f.node.IsSequence() ? fmt::format("a list of {}", f.node.size())
+                                                      : describe(f.node)));
+  }
+  Eigen::Vector4d v;
+  for (std::size_t i = 0; i < 4; ++i)
+    v[static_cast<Eigen::Index>(i)] =
+        read_number(ctx, Field{f.node[i], f.key_mark, index_path(f.path, i)}, b);
+  return v;
+}
+
+void parse_control_uavs(const Ctx& ctx, const Field& f, std::vector<UavControlSpec>& out) {
+  if (!f.node.IsSequence() || f.node.size() == 0)
+    ctx.fail(f.loc(), fmt::format("expected a list of controlled UAVs, got {}", describe(f.node)));
+  out.clear();
+  std::vector<Loc> name_locs;
+  for (std::size_t i = 0; i < f.node.size(); ++i) {
+    const Field item{f.node[i], f.key_mark, index_path(f.path, i)};
+    MapView m(ctx, item, {"name", "initial_yaw", "lambda_d", "yaw_d"});
+    UavControlSpec u;
+    const Field nf = m.require("name", item.loc());
+    u.uav = read_string(ctx, nf);
+    for (std::size_t j = 0; j < out.size(); ++j)
+      if (out[j].uav == u.uav)
+        ctx.fail(nf.loc(), fmt::format("duplicate UAV '{}' (first at line {})", u.uav,
+                                       name_locs[j].mark.line + 1));
+    num(ctx, m, "initial_yaw", u.initial_yaw, in(-2 * M_PI, 2 * M_PI));
+    set_if(m, "lambda_d", u.lambda_d, [&](const Field& x) { return read_vec3(ctx, x); });
+    if (auto y = m.get("yaw_d")) {
+      if (y->node.IsScalar() && y->node.Scalar() == "lead_bearing")
+        u.yaw_d.reset();
+      else if (y->node.IsScalar() && !y->node.Scalar().empty() &&
+               (std::isdigit(static_cast<unsigned char>(y->node.Scalar()[0])) ||
+                std::string_view("+-.").find(y->node.Scalar()[0]) != std::string_view::npos))
+        u.yaw_d = read_number(ctx, *y, in(-2 * M_PI, 2 * M_PI));
+      else
+        ctx.fail(y->loc(), fmt::format("expected lead_bearing or a yaw in radians, got {}",
+                                       describe(y->node)));
+    }
+    out.push_back(std::move(u));
+    name_locs.push_back(nf.loc());
+  }
+}
+
+// The section's presence turns the closed loop on; every UAV of the scenario needs an entry
+// (default: section 7.3's uav1 and uav2).
+void parse_control(const Ctx& ctx, const Field& f, ControlSpec& c, const std::vector<UavSpec>& uavs) {
+  MapView m(ctx, f,
+            {"settling_time", "k1", "k2", "switching", "boundary_width", "limits", "anti_windup",
+             "lead_bearing_min_range", "disturbance", "uavs"});
+  c.enabled = true;
+  num(ctx, m, "settling_time", c.settling_time, ge(0));
+  set_if(m, "k1", c.k1, [&](const Field& x) { return read_vec4(ctx, x, ge(0)); });
+  set_if(m, "k2", c.k2, [&](const Field& x) { return read_vec4(ctx, x, gt(0)); });
+  if (auto sf = m.get("switching")) {
+    const std::string& s = scalar_of(ctx, *sf, "sign, sat or tanh");
+    if (s == "sign")
+      c.switching = SwitchingSpec::Sign;
+    else if (s == "sat")
+      c.switching = SwitchingSpec::Saturation;
+    else if (s == "tanh")
+      c.switching = SwitchingSpec::Tanh;
+    else
+      ctx.fail(sf->loc(), fmt::format("expected sign, sat or tanh, got '{}'{}", s,
+                                      suggestion(s, {"sign", "sat", "tanh"})));
+  }
+  set_if(m, "boundary_width", c.boundary_width, [&](const Field& x) { return read_vec4(ctx, x, gt(0)); });
+  if (auto lf = m.get("limits")) {
+    MapView l(ctx, *lf, {"horizontal_speed", "vertical_speed", "yaw_rate", "acceleration"});
+    num(ctx, l, "horizontal_speed", c.max_horizontal_speed, gt(0));
+    num(ctx, l, "vertical_speed", c.max_vertical_speed, gt(0));
+    num(ctx, l, "yaw_rate", c.max_yaw_rate, gt(0));
+    num(ctx, l, "acceleration", c.max_acceleration, ge(0));
+  }
+  boolean(ctx, m, "anti_windup", c.anti_windup);
+  num(ctx, m, "lead_bearing_min_range", c.lead_bearing_min_range, ge(0));
+  if (auto df = m.get("disturbance")) {
+    MapView d(ctx, *df, {"bound", "seed"});
+    set_if(d, "bound", c.disturbance_bound, [&](const Field& x) { return read_vec4(ctx, x, ge(0)); });
+    if (auto s = d.get("seed")) c.disturbance_seed = read_seed(ctx, *s);
+  }
+  const auto uf = m.get("uavs");
+  if (uf) parse_control_uavs(ctx, *uf, c.uavs);
+  else if (c.uavs.empty()) c.uavs = paper_control_uavs();
+  const Loc where = uf ? uf->loc() : f.key_loc();
+  for (const UavControlSpec& u : c.uavs) {
+    const bool known = std::any_of(uavs.begin(), uavs.end(), [&](const UavSpec& s) { return s.name == u.uav; });
+    if (!known) {
+      std::vector<std::string_view> names;
+      for (const UavSpec& s : uavs) names.push_back(s.name);
+      ctx.fail(where, fmt::format("'{}' is not a UAV of this scenario (UAVs: {})", u.uav, join(names)));
+    }
+  }
+  for (const UavSpec& s : uavs) {
+    if (std::none_of(c.uavs.begin(), c.uavs.end(), [&](const UavControlSpec& u) { return u.uav == s.name; }))
+      ctx.fail(where, fmt::format("UAV '{}' has no entry; in closed loop every UAV needs its "
+                                  "lambda_d and initial_yaw", s.name));
+  }
+}
+
 // The sections a variant may override; the top level parses them with the same code.
-const std::vector<std::string_view> kCommonKeys = {"seed",   "duration", "noise",    "landmarks",
-                                                   "phases", "outages",  "estimator"};
+const std::vector<std::string_view> kCommonKeys = {"seed",   "duration", "noise",     "landmarks",
+                                                   "phases", "outages",  "estimator", "control"};
 
 void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& prov) {
   if (auto f = m.get("seed")) s.seed = read_seed(ctx, *f);
@@ -628,6 +734,7 @@ void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& pro
   if (auto f = m.get("phases")) parse_phases(ctx, *f, s.phases, prov);
   if (auto f = m.get("outages")) parse_outages(ctx, *f, s.outages, prov);
   if (auto f = m.get("estimator")) parse_estimator(ctx, *f, s.estimator, prov);
+  if (auto f = m.get("control")) parse_control(ctx, *f, s.control, s.uavs);
 }
 
 std::string uav_names(const Scenario& s) {
@@ -681,6 +788,9 @@ void finalise(const Ctx& ctx, Scenario& s, const Provenance& prov) {
                                     "UAVs, got {}; add a UAV or set estimator.mode: single",
                                     s.uavs.size()));
   }
+  if (s.closed_loop() && e.mode == EstimatorMode::SingleUav)
+    ctx.fail(prov.mode, "closed loop (the control: section) needs mode multi: the controller of "
+                        "every UAV takes its position from the estimator");
   if (e.target_landmarks_per_camera > e.max_landmarks) {
     if (prov.target_per_camera.valid())
       ctx.fail(prov.target_per_camera, fmt::format("must not exceed max_landmarks ({}), got {}",
@@ -704,7 +814,8 @@ std::vector<UavSpec> paper_uavs() {
 std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   const std::vector<std::string_view> top_keys = {
       "name",  "duration",  "rate",   "seed",    "measurements", "lead",    "uavs",
-      "noise", "landmarks", "phases", "outages", "estimator",    "variants"};
+      "noise", "landmarks", "phases", "outages", "estimator",    "control",
+      "variants"};
   if (!root.IsMap()) {
     ctx.fail(root.Mark(), "",
              fmt::format("expected a map of scenario settings at the top level, got {}",

@@ -7,7 +7,7 @@
 
 namespace wingman::sim {
 
-std::vector<Eigen::Vector3d> make_landmark_field(const Scenario& scn, const OpenLoopTruth& truth) {
+std::vector<Eigen::Vector3d> make_landmark_field(const Scenario& scn, const Truth& truth) {
   const Eigen::Vector4d box = truth.horizontal_extent();
   const double m = scn.field.margin;
   const double x0 = box(0) - m, y0 = box(1) - m, x1 = box(2) + m, y1 = box(3) + m;
@@ -24,7 +24,7 @@ std::vector<Eigen::Vector3d> make_landmark_field(const Scenario& scn, const Open
   return pts;
 }
 
-SyntheticSource::SyntheticSource(const Scenario& scn, const OpenLoopTruth& truth)
+SyntheticSource::SyntheticSource(const Scenario& scn, const Truth& truth)
     : scn_(scn),
       truth_(truth),
       field_(make_landmark_field(scn, truth)),
@@ -34,6 +34,7 @@ SyntheticSource::SyntheticSource(const Scenario& scn, const OpenLoopTruth& truth
       gps_rng_(make_stream(scn.seed, "gps")),
       alt_rng_(make_stream(scn.seed, "altimeter")),
       range_rng_(make_stream(scn.seed, "range")),
+      ahrs_rng_(make_stream(scn.seed, "ahrs")),
       injected_(scn.uavs.size() + 1, 0) {}
 
 void SyntheticSource::bind(std::int64_t landmark, std::size_t point) {
@@ -186,6 +187,12 @@ double SyntheticSource::altimeter(int uav, double t) {
 double SyntheticSource::range(int uav, double t) {
   std::normal_distribution<double> n(0.0, scn_.noise.range_sigma);
   return (truth_.lead(t).position - truth_.uav(uav, t).position).norm() + n(range_rng_);
+}
+
+double SyntheticSource::ahrs_yaw(int uav, double t) {
+  std::normal_distribution<double> n(0.0, scn_.noise.ahrs_yaw_sigma);
+  double a = std::remainder(truth_.uav_yaw(uav, t) + n(ahrs_rng_), 2 * M_PI);
+  return a <= -M_PI ? a + 2 * M_PI : a;
 }
 
 }  // namespace wingman::sim

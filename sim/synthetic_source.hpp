@@ -20,7 +20,7 @@
 namespace wingman::sim {
 
 // Points scattered over the ground below the flight, reproducible from the seed.
-std::vector<Eigen::Vector3d> make_landmark_field(const Scenario& scn, const OpenLoopTruth& truth);
+std::vector<Eigen::Vector3d> make_landmark_field(const Scenario& scn, const Truth& truth);
 
 struct PixelObservation {
   std::int64_t landmark = -1;  // the filter's id, or -1 for a new point
@@ -39,7 +39,7 @@ struct PointPair {
 
 class SyntheticSource {
  public:
-  SyntheticSource(const Scenario& scn, const OpenLoopTruth& truth);
+  SyntheticSource(const Scenario& scn, const Truth& truth);
 
   const std::vector<Eigen::Vector3d>& field() const { return field_; }
   void bind(std::int64_t landmark, std::size_t point);
@@ -61,6 +61,7 @@ class SyntheticSource {
   Eigen::Vector3d gps(double t);
   double altimeter(int uav, double t);
   double range(int uav, double t);
+  double ahrs_yaw(int uav, double t);  // truth yaw plus N(0, ahrs_yaw_sigma), wrapped
 
   long injected_outliers(int uav) const { return injected_[uav]; }
 
@@ -71,11 +72,11 @@ class SyntheticSource {
   std::vector<std::size_t> spread(int uav, double t, std::vector<std::size_t> candidates, int count);
 
   const Scenario& scn_;
-  const OpenLoopTruth& truth_;
+  const Truth& truth_;
   std::vector<Eigen::Vector3d> field_;
   std::unordered_map<std::int64_t, std::size_t> bound_;
   std::unordered_set<std::size_t> bound_points_;
-  std::mt19937_64 pixel_rng_, outlier_rng_, select_rng_, gps_rng_, alt_rng_, range_rng_;
+  std::mt19937_64 pixel_rng_, outlier_rng_, select_rng_, gps_rng_, alt_rng_, range_rng_, ahrs_rng_;
   std::vector<long> injected_;
 };
 

@@ -20,7 +20,7 @@ KinematicState lemniscate(const LeadTrajectorySpec& p, double t) {
 }
 
 OpenLoopTruth::OpenLoopTruth(const Scenario& scn)
-    : scn_(scn), origin_(lemniscate(scn.lead.trajectory, 0).position) {}
+    : Truth(scn), origin_(lemniscate(scn.lead.trajectory, 0).position) {}
 
 KinematicState OpenLoopTruth::lead(double t) const {
   KinematicState k = lemniscate(scn_.lead.trajectory, t);
@@ -34,15 +34,15 @@ KinematicState OpenLoopTruth::uav(int j, double t) const {
   return k;
 }
 
-KinematicState OpenLoopTruth::camera(int j, double t) const {
+KinematicState Truth::camera(int j, double t) const {
   KinematicState k = uav(j, t);
   k.position += scn_.uavs[j].camera.offset;
   return k;
 }
 
-Eigen::Matrix3d OpenLoopTruth::commanded_R_CW() const { return geometry::nadir_R_CW(); }
+Eigen::Matrix3d Truth::commanded_R_CW() const { return geometry::nadir_R_CW(); }
 
-Eigen::Matrix3d OpenLoopTruth::camera_R_CW(double t) const {
+Eigen::Matrix3d Truth::camera_R_CW(double t) const {
   const double e = scn_.noise.gimbal_amplitude * std::sin(scn_.noise.gimbal_omega * t);
   return geometry::gimbal_error(e) * commanded_R_CW();
 }

@@ -1,6 +1,7 @@
 // Ground-truth motion of the open-loop runs: the lead follows the lemniscate of paper eq. 66 and
 // every UAV the same curve shifted by its initial offset (DESIGN.md §3); the cameras carry the
 // gimbal error e_r(t) = A sin(w t) about their x and y axes, which the filter never sees.
+// Truth is the interface the synthetic source reads; closed_loop_truth.hpp is the other one.
 #pragma once
 
 #include <Eigen/Core>
@@ -17,20 +18,37 @@ struct KinematicState {
 // eq. 66 and its time derivative, unshifted.
 KinematicState lemniscate(const LeadTrajectorySpec& spec, double t);
 
-class OpenLoopTruth {
+// What the synthetic measurements are made from: the lead, the UAVs and their cameras. The
+// open-loop truth knows every instant in advance; the closed-loop one only the current step.
+class Truth {
  public:
-  explicit OpenLoopTruth(const Scenario& scn);
-  KinematicState lead(double t) const;
-  KinematicState uav(int j, double t) const;     // the UAV's body position
+  explicit Truth(const Scenario& scn) : scn_(scn) {}
+  virtual ~Truth() = default;
+  virtual KinematicState lead(double t) const = 0;
+  virtual KinematicState uav(int j, double t) const = 0;  // the UAV's body position
+  virtual double uav_yaw(int j, double t) const = 0;      // psi of eq. 53
+  // Horizontal bounding box [xmin, ymin, xmax, ymax] of every agent over the run.
+  virtual Eigen::Vector4d horizontal_extent() const = 0;
   KinematicState camera(int j, double t) const;  // body plus the offset d (eq. 59)
-  // The camera's true orientation: commanded nadir R_CW with the gimbal error applied.
+  // The camera's true orientation: commanded nadir R_CW with the gimbal error applied. The
+  // gimbal holds it whatever the UAV's yaw.
   Eigen::Matrix3d camera_R_CW(double t) const;
   Eigen::Matrix3d commanded_R_CW() const;
-  // Horizontal bounding box [xmin, ymin, xmax, ymax] of every agent over the run.
-  Eigen::Vector4d horizontal_extent() const;
+  const Scenario& scenario() const { return scn_; }
+
+ protected:
+  const Scenario& scn_;
+};
+
+class OpenLoopTruth : public Truth {
+ public:
+  explicit OpenLoopTruth(const Scenario& scn);
+  KinematicState lead(double t) const override;
+  KinematicState uav(int j, double t) const override;
+  double uav_yaw(int, double) const override { return 0.0; }  // the open-loop UAVs do not turn
+  Eigen::Vector4d horizontal_extent() const override;
 
  private:
-  const Scenario& scn_;
   Eigen::Vector3d origin_;  // the curve's value at t = 0
 };
 
