@@ -37,6 +37,7 @@ struct ObsOptions {
   double state_tol = 1e-6;
   std::string scenario, variant;
   double at = 0;
+  CLI::Option* at_opt = nullptr;
   bool json = false;
 };
 
@@ -214,6 +215,8 @@ int observability_command(const ObsOptions& o) {
   if (!(o.tol > 0 && o.tol < 1)) throw UsageError("--tol: must be in (0, 1)");
   if (!(o.state_tol > 0 && o.state_tol < 1)) throw UsageError("--state-tol: must be in (0, 1)");
   if (o.config && (*o.config < 1 || *o.config > 3)) throw UsageError("--config: must be 1, 2 or 3");
+  if (o.scenario.empty() && (o.at_opt->count() > 0 || !o.variant.empty()))
+    throw UsageError("--at and --variant need --scenario");
 
   // Where to evaluate, and the sensor set to start from.
   slam::EvaluationPoint point;
@@ -357,7 +360,7 @@ Subcommand add_observability(CLI::App& parent) {
   cmd->add_option("--scenario", o->scenario, "Evaluate at the true state of this scenario's trajectory")
       ->check(CLI::ExistingFile);
   cmd->add_option("--variant", o->variant, "Scenario variant (default: the first)");
-  cmd->add_option("--at", o->at, "Time on the scenario's trajectory, s (default 0)");
+  o->at_opt = cmd->add_option("--at", o->at, "Time on the scenario's trajectory, s (default 0)");
   cmd->add_flag("--json", o->json, "Print JSON (dim, rank, unobservable_modes, null_space, observable, ...)");
   return {cmd, [o] { return observability_command(*o); }};
 }

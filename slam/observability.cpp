@@ -123,7 +123,7 @@ Eigen::MatrixXd stencil_weights(int m) {
       term *= static_cast<double>(i - m) / (p + 1);
     }
   }
-  // Rows of W solve W V^T... i.e. W = V^{-1} transposed appropriately: V w_k = e_k.
+  // Row k of W solves V w = e_k: the weights reproduce the k-th Taylor coefficient.
   return V.fullPivLu().solve(Eigen::MatrixXd::Identity(n, n)).transpose();
 }
 

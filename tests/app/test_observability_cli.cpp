@@ -86,6 +86,7 @@ TEST_F(ObservabilityCli, BadInputExits2) {
   expect_usage_error({"--uavs", "0"}, "--uavs");
   expect_usage_error({"--scenario", "no/such/file.yaml"}, "file.yaml");
   expect_usage_error({"--scenario", (kSourceDir / "scenes" / "smoke.yaml").string(), "--at", "1e6"}, "--at");
+  expect_usage_error({"--at", "3"}, "need --scenario");
   expect_usage_error({"--bogus"}, "bogus");
 }
 
