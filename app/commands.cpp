@@ -19,6 +19,7 @@ int run_cli(int argc, char** argv) {
   const std::vector<Subcommand> commands = {
       add_run(cli),
       add_montecarlo(cli),
+      add_observability(cli),
   };
 
   try {

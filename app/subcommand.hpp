@@ -22,8 +22,9 @@ struct Subcommand {
   std::function<int()> run;    // runs it after parsing; returns the exit code
 };
 
-Subcommand add_run(CLI::App& parent);         // app/cmd_run.cpp
-Subcommand add_montecarlo(CLI::App& parent);  // app/cmd_montecarlo.cpp
+Subcommand add_run(CLI::App& parent);            // app/cmd_run.cpp
+Subcommand add_montecarlo(CLI::App& parent);     // app/cmd_montecarlo.cpp
+Subcommand add_observability(CLI::App& parent);  // app/cmd_observability.cpp
 // Further subcommands declare their add_<name>() here.
 
 }  // namespace wingman::app
