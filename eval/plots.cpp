@@ -413,7 +413,7 @@ fs::path plot_monte_carlo_nees(const std::vector<MonteCarloSummary>& summaries, 
   std::string body = phase_marks(phases, true) +
                      "set title 'Average NEES over Monte Carlo runs (agents'' positions and "
                      "velocities)'\nset xlabel 't [s]'\nset ylabel 'average NEES'\nset logscale y\n"
-                     "set key top left opaque box\n";
+                     "set key bottom right opaque box\nset yrange [1:*]\n";
   std::string plot = "plot ";
   for (std::size_t i = 0; i < summaries.size(); ++i) {
     const auto& m = summaries[i];
