@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geometry/camera.hpp"
+#include "sim/world.hpp"
 
 namespace wingman::sim {
 
@@ -153,6 +154,7 @@ struct Scenario {
   std::vector<Phase> phases;
   std::vector<Outage> outages;
   EstimatorSpec estimator{};
+  WorldSpec world{};  // what `wingman render` draws (sim/world.hpp)
 
   double dt() const { return 1.0 / rate; }
   int num_steps() const;  // steps after t = 0
