@@ -18,6 +18,7 @@ int run_cli(int argc, char** argv) {
 
   const std::vector<Subcommand> commands = {
       add_run(cli),
+      add_render(cli),
   };
 
   try {

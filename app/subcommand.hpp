@@ -22,7 +22,8 @@ struct Subcommand {
   std::function<int()> run;    // runs it after parsing; returns the exit code
 };
 
-Subcommand add_run(CLI::App& parent);  // app/cmd_run.cpp
+Subcommand add_run(CLI::App& parent);     // app/cmd_run.cpp
+Subcommand add_render(CLI::App& parent);  // app/cmd_render.cpp
 // Further subcommands declare their add_<name>() here.
 
 }  // namespace wingman::app

@@ -113,14 +113,14 @@ std::vector<WorldObject> scatter_objects(const Scenario& scn, const TerrainModel
           break;
         }
         case WorldObject::Type::Tree: {
-          const double h = 4 + 5 * u(rng);
+          const double h = 3 + 3 * u(rng);
           o.size = {h * 0.45, h * 0.45, h};
           o.colour = {0.18 + 0.1 * u(rng), 0.38 + 0.15 * u(rng), 0.15 + 0.08 * u(rng)};
           footprint = o.size.x() / 2;
           break;
         }
         case WorldObject::Type::Building: {
-          o.size = {6 + 8 * u(rng), 5 + 6 * u(rng), 3 + 5 * u(rng)};
+          o.size = {6 + 8 * u(rng), 5 + 6 * u(rng), 2.5 + 2.5 * u(rng)};
           const double g = 0.6 + 0.3 * u(rng);
           o.colour = {g, g * (0.85 + 0.1 * u(rng)), g * (0.75 + 0.15 * u(rng))};
           footprint = 0.5 * o.size.head<2>().norm();
