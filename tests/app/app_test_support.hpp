@@ -86,7 +86,10 @@ inline RunResult run_wingman(const std::vector<std::string>& args, const fs::pat
   cmd += quote(cwd.string());
   cmd += " && ";
   cmd += quote(kBinary.string());
-  for (const auto& a : args) cmd += " " + quote(a);
+  for (const auto& a : args) {
+    cmd += ' ';
+    cmd += quote(a);
+  }
   cmd += " > ";
   cmd += quote(log.string());
   cmd += " 2>&1";
