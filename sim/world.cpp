@@ -41,7 +41,7 @@ TerrainModel::TerrainModel(const Scenario& scn, const OpenLoopTruth& truth)
   if (follow_) {
     const double h = lead_reference_height(scn.world);
     // Every 0.1 s: the nearest sample is then within a few cm of the nearest path point.
-    const int n = static_cast<int>(std::ceil(scn.duration / 0.1));
+    const int n = std::max(1, static_cast<int>(std::ceil(scn.duration / 0.1)));  // duration may be 0
     for (int k = 0; k <= n; ++k) {
       const Eigen::Vector3d p = truth.lead(k * scn.duration / n).position;
       path_.emplace_back(p.x(), p.y(), p.z() - h);

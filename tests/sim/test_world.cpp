@@ -79,6 +79,11 @@ TEST(World, TerrainFollowsAGroundLeadAndIsSeeded) {
     const Eigen::Vector3d p = truth.lead(t).position;
     EXPECT_NEAR(terrain.height(p.x(), p.y()), p.z() - lead_reference_height(s.world), 0.02) << t;
   }
+  // A zero-length run (one frame) still has its road.
+  Scenario one = s;
+  one.duration = 0;
+  const TerrainModel terrain0(one, truth);
+  EXPECT_NEAR(terrain0.height(0, 0), -lead_reference_height(s.world), 1e-9);
   // Away from the path: the seeded relief, within its amplitude.
   Scenario other = s;
   other.seed = s.seed + 1;
