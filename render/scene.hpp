@@ -17,7 +17,7 @@ struct Material {
   cv::Mat texture;  // CV_8UC3 or CV_8UC4, RGB(A) order, row 0 at t = 0; empty: plain white
   bool repeat = true;
   bool mipmaps = true;
-  double anisotropy = 16;
+  double anisotropy = 4;
   bool unlit = false;  // colour shown as is (markers, test targets)
 };
 

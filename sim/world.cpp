@@ -75,9 +75,11 @@ double TerrainModel::height(double x, double y) const {
   double road = 0;
   const double d = distance_to_path(x, y, &road);
   if (d <= spec_.road_half_width) return road;
+  // Around a ground lead the land follows its road (which rises and falls with the lead) plus
+  // the relief, so the road is neither a trench nor a dyke.
   const double s = std::min(1.0, (d - spec_.road_half_width) / spec_.road_blend);
   const double w = s * s * (3 - 2 * s);  // smoothstep
-  return (1 - w) * road + w * base;
+  return road + w * (base - spec_.mean_height);
 }
 
 Eigen::Vector3d TerrainModel::normal(double x, double y) const {

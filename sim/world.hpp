@@ -17,7 +17,7 @@ class OpenLoopTruth;
 struct TerrainSpec {
   double extent = 0;          // m, side of the square terrain; 0: the flight's extent plus margin
   double margin = 60;         // m around the flight when extent is 0 (a nadir camera at 17 m sees +-42 m)
-  double mean_height = 0;     // m
+  double mean_height = 0;     // m (an aerial lead; around a ground lead the land follows its road)
   double relief = 1.5;        // m, peak amplitude of the seeded undulation
   double relief_scale = 40;   // m, wavelength of the largest undulation
   double resolution = 2;      // m between mesh vertices
@@ -35,7 +35,9 @@ struct TextureSpec {
   double detail_min = 0.02;  // m, finest and coarsest detail of the procedural texture
   double detail_max = 0.2;
   int size = 2048;           // px of the procedural texture (one tile, detail_min per texel)
-  double anisotropy = 16;    // max anisotropic filtering; 1 disables it
+  // Max anisotropic filtering; 1 disables it. A nadir camera with the paper's 136 deg field of
+  // view sees the ground at most 68 deg off-axis, an anisotropy of about 2.7: 4 is enough.
+  double anisotropy = 4;
 };
 
 struct ObjectsSpec {
@@ -84,8 +86,9 @@ struct WorldSpec {
   double near = 0.1, far = 1000;  // m, clip planes
 };
 
-// Terrain heights: mean plus seeded smooth relief, flattened under a ground lead's path so that
-// its wheels follow the lead's true height (DESIGN.md §3).
+// Terrain heights: seeded smooth relief around the mean height; with a ground lead, a flat road
+// under its path at the lead's true height minus its reference height (its wheels never float or
+// sink, DESIGN.md §3), and the land around it that road's height plus the relief.
 class TerrainModel {
  public:
   TerrainModel(const Scenario& scn, const OpenLoopTruth& truth);
