@@ -84,16 +84,23 @@ sim::Scenario pick(const RenderOptions& o) {
     scn = *it;
   }
   if (o.seed) scn.seed = *o.seed;
+  return scn;
+}
+
+// Steps to render (after t = 0): the whole run, or what --frames / --duration keep. The world
+// is always built for the whole run, so a short preview shows exactly the full run's first frames.
+int steps_to_render(const RenderOptions& o, const sim::Scenario& scn) {
+  int n = scn.num_steps();
   if (o.frames && o.duration) throw UsageError("--frames and --duration exclude each other");
   if (o.frames) {
     if (*o.frames < 1) throw UsageError("--frames must be at least 1");
-    scn.duration = std::min(scn.duration, (*o.frames - 1) / scn.rate);
+    n = std::min(n, *o.frames - 1);
   }
   if (o.duration) {
     if (!(*o.duration >= 0)) throw UsageError("--duration must be >= 0");
-    scn.duration = std::min(scn.duration, *o.duration);
+    n = std::min(n, static_cast<int>(std::floor(*o.duration * scn.rate + 1e-9)));
   }
-  return scn;
+  return n;
 }
 
 datasets::PoseSample pose(std::int64_t t, const Eigen::Vector3d& p, const Eigen::Matrix3d& R,
@@ -108,8 +115,8 @@ int render_command(const RenderOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  // Truncating the run may end phases early; the world does not depend on them.
-  sim::Scenario scn = pick(o);
+  const sim::Scenario scn = pick(o);
+  const int n = steps_to_render(o, scn);
   const fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);
 
   render::Scene scene;
@@ -157,7 +164,6 @@ int render_command(const RenderOptions& o) {
   }
 
   InterruptGuard guard;
-  const int n = scn.num_steps();
   const int cams = static_cast<int>(scn.uavs.size());
   ProgressLine progress(fmt::format("[render {}]", scn.name), o.quiet);
   const auto start = std::chrono::steady_clock::now();
