@@ -53,7 +53,7 @@ struct MonteCarloOptions {
 };
 
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted = true; }
+extern "C" void montecarlo_on_interrupt(int) { g_interrupted = true; }
 
 fs::path run_dir(const fs::path& out, std::uint64_t seed) {
   return out / "runs" / fmt::format("seed{}", seed);
@@ -155,7 +155,7 @@ int montecarlo_command(const MonteCarloOptions& o) {
     fmt::print(stderr, "resuming: {} of {} runs already finished\n", finished.size(), o.runs);
 
   struct sigaction sa {};
-  sa.sa_handler = on_interrupt;
+  sa.sa_handler = montecarlo_on_interrupt;
   sigemptyset(&sa.sa_mask);
   struct sigaction old_int {}, old_term {};
   sigaction(SIGINT, &sa, &old_int);

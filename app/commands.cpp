@@ -20,6 +20,7 @@ int run_cli(int argc, char** argv) {
       add_run(cli),
       add_montecarlo(cli),
       add_observability(cli),
+      add_render(cli),
   };
 
   try {

@@ -25,6 +25,7 @@ struct Subcommand {
 Subcommand add_run(CLI::App& parent);            // app/cmd_run.cpp
 Subcommand add_montecarlo(CLI::App& parent);     // app/cmd_montecarlo.cpp
 Subcommand add_observability(CLI::App& parent);  // app/cmd_observability.cpp
+Subcommand add_render(CLI::App& parent);         // app/cmd_render.cpp
 // Further subcommands declare their add_<name>() here.
 
 }  // namespace wingman::app

@@ -11,6 +11,7 @@
 
 #include "geometry/camera.hpp"
 #include "sim/control_spec.hpp"
+#include "sim/world.hpp"
 
 namespace wingman::sim {
 
@@ -158,6 +159,7 @@ struct Scenario {
   std::vector<Outage> outages;
   EstimatorSpec estimator{};
   ControlSpec control{};  // enabled: closed loop (section 6)
+  WorldSpec world{};  // what `wingman render` draws (sim/world.hpp)
 
   double dt() const { return 1.0 / rate; }
   int num_steps() const;  // steps after t = 0

@@ -722,6 +722,129 @@ void parse_control(const Ctx& ctx, const Field& f, ControlSpec& c, const std::ve
   }
 }
 
+// ---- World (sim/world.hpp): what `wingman render` draws --------------------------------------
+
+template <typename E>
+E read_enum(const Ctx& ctx, const Field& f, const std::vector<std::pair<std::string_view, E>>& v) {
+  const std::string& s = scalar_of(ctx, f, "a name");
+  std::vector<std::string_view> names;
+  for (const auto& [n, e] : v) {
+    if (n == s) return e;
+    names.push_back(n);
+  }
+  ctx.fail(f.loc(), fmt::format("unknown value '{}'{}; expected one of {}", s, suggestion(s, names),
+                                join(names)));
+}
+
+void parse_world_terrain(const Ctx& ctx, const Field& f, TerrainSpec& t) {
+  MapView m(ctx, f, {"extent", "margin", "mean_height", "relief", "relief_scale", "resolution",
+                     "road_half_width", "road_blend"});
+  num(ctx, m, "extent", t.extent, ge(0));
+  num(ctx, m, "margin", t.margin, ge(0));
+  num(ctx, m, "mean_height", t.mean_height);
+  num(ctx, m, "relief", t.relief, ge(0));
+  num(ctx, m, "relief_scale", t.relief_scale, gt(0));
+  num(ctx, m, "resolution", t.resolution, in(0.1, 50));
+  num(ctx, m, "road_half_width", t.road_half_width, ge(0));
+  num(ctx, m, "road_blend", t.road_blend, gt(0));
+}
+
+void parse_world_texture(const Ctx& ctx, const Field& f, TextureSpec& t) {
+  MapView m(ctx, f, {"type", "image", "mode", "tile_size", "detail_min", "detail_max", "size",
+                     "anisotropy"});
+  if (auto x = m.get("type"))
+    t.type = read_enum<TextureSpec::Type>(
+        ctx, *x, {{"image", TextureSpec::Type::Image}, {"procedural", TextureSpec::Type::Procedural}});
+  if (auto x = m.get("image")) t.image = read_string(ctx, *x);
+  if (auto x = m.get("mode"))
+    t.mode = read_enum<TextureSpec::Mode>(
+        ctx, *x, {{"tiled", TextureSpec::Mode::Tiled}, {"stretched", TextureSpec::Mode::Stretched}});
+  num(ctx, m, "tile_size", t.tile_size, gt(0));
+  auto lo = num(ctx, m, "detail_min", t.detail_min, gt(0));
+  auto hi = num(ctx, m, "detail_max", t.detail_max, gt(0));
+  if (t.detail_max < t.detail_min)
+    ctx.fail(hi ? hi->loc() : loc_of(lo),
+             fmt::format("detail_max ({}) must be at least detail_min ({})", t.detail_max,
+                         t.detail_min));
+  set_if(m, "size", t.size, [&](const Field& x) { return read_int(ctx, x, 16, 8192); });
+  num(ctx, m, "anisotropy", t.anisotropy, in(1, 64));
+}
+
+void parse_world_objects(const Ctx& ctx, const Field& f, ObjectsSpec& o) {
+  MapView m(ctx, f, {"boulders", "trees", "buildings", "clearance"});
+  num(ctx, m, "boulders", o.boulders, in(0, 10000));
+  num(ctx, m, "trees", o.trees, in(0, 10000));
+  num(ctx, m, "buildings", o.buildings, in(0, 1000));
+  num(ctx, m, "clearance", o.clearance, ge(0));
+}
+
+void parse_world_lead(const Ctx& ctx, const Field& f, LeadModelSpec& l) {
+  MapView m(ctx, f, {"model", "kind", "height", "up", "yaw_offset", "cue", "aruco_id",
+                     "marker_size", "panel_colour"});
+  if (auto x = m.get("model")) l.model = read_string(ctx, *x);
+  if (auto x = m.get("kind"))
+    l.kind = read_enum<LeadModelSpec::Kind>(
+        ctx, *x, {{"ground", LeadModelSpec::Kind::Ground}, {"aerial", LeadModelSpec::Kind::Aerial}});
+  num(ctx, m, "height", l.height, gt(0));
+  if (auto x = m.get("up"))
+    l.up = read_enum<std::string>(ctx, *x, {{"y", "y"}, {"z", "z"}});
+  num(ctx, m, "yaw_offset", l.yaw_offset);
+  if (auto x = m.get("cue"))
+    l.cue = read_enum<LeadModelSpec::Cue>(ctx, *x,
+                                          {{"aruco", LeadModelSpec::Cue::Aruco},
+                                           {"panel", LeadModelSpec::Cue::Panel},
+                                           {"none", LeadModelSpec::Cue::None}});
+  set_if(m, "aruco_id", l.aruco_id, [&](const Field& x) { return read_int(ctx, x, 0, 49); });
+  num(ctx, m, "marker_size", l.marker_size, gt(0));
+  if (auto x = m.get("panel_colour")) {
+    l.panel_colour = read_vec3(ctx, *x);
+    if (l.panel_colour.minCoeff() < 0 || l.panel_colour.maxCoeff() > 1)
+      ctx.fail(x->loc(), "colour components must be in [0, 1]");
+  }
+}
+
+void parse_world_light(const Ctx& ctx, const Field& f, LightSpec& l) {
+  MapView m(ctx, f, {"direction", "ambient", "diffuse"});
+  if (auto x = m.get("direction")) {
+    l.direction = read_vec3(ctx, *x);
+    if (l.direction.norm() < 1e-9) ctx.fail(x->loc(), "must not be the zero vector");
+  }
+  num(ctx, m, "ambient", l.ambient, in(0, 2));
+  num(ctx, m, "diffuse", l.diffuse, in(0, 2));
+}
+
+void parse_world_image(const Ctx& ctx, const Field& f, ImageEffectsSpec& e) {
+  MapView m(ctx, f, {"msaa", "noise_sigma", "blur_sigma", "exposure_gain", "exposure_variation",
+                     "sky"});
+  if (auto x = m.get("msaa")) {
+    e.msaa = read_int(ctx, *x, 1, 16);
+    if ((e.msaa & (e.msaa - 1)) != 0) ctx.fail(x->loc(), fmt::format("must be 1, 2, 4, 8 or 16, got {}", e.msaa));
+  }
+  num(ctx, m, "noise_sigma", e.noise_sigma, ge(0));
+  num(ctx, m, "blur_sigma", e.blur_sigma, ge(0));
+  num(ctx, m, "exposure_gain", e.exposure_gain, gt(0));
+  num(ctx, m, "exposure_variation", e.exposure_variation, in(0, 1));
+  if (auto x = m.get("sky")) {
+    e.sky = read_vec3(ctx, *x);
+    if (e.sky.minCoeff() < 0 || e.sky.maxCoeff() > 1)
+      ctx.fail(x->loc(), "colour components must be in [0, 1]");
+  }
+}
+
+void parse_world(const Ctx& ctx, const Field& f, WorldSpec& w) {
+  MapView m(ctx, f, {"terrain", "texture", "objects", "lead", "light", "image", "near", "far"});
+  if (auto x = m.get("terrain")) parse_world_terrain(ctx, *x, w.terrain);
+  if (auto x = m.get("texture")) parse_world_texture(ctx, *x, w.texture);
+  if (auto x = m.get("objects")) parse_world_objects(ctx, *x, w.objects);
+  if (auto x = m.get("lead")) parse_world_lead(ctx, *x, w.lead);
+  if (auto x = m.get("light")) parse_world_light(ctx, *x, w.light);
+  if (auto x = m.get("image")) parse_world_image(ctx, *x, w.image);
+  num(ctx, m, "near", w.near, gt(0));
+  auto ff = num(ctx, m, "far", w.far, gt(0));
+  if (w.far <= w.near)
+    ctx.fail(ff ? ff->loc() : f.loc(), fmt::format("far ({}) must exceed near ({})", w.far, w.near));
+}
+
 // The sections a variant may override; the top level parses them with the same code.
 const std::vector<std::string_view> kCommonKeys = {"seed",   "duration", "noise",     "landmarks",
                                                    "phases", "outages",  "estimator", "control"};
@@ -815,7 +938,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   const std::vector<std::string_view> top_keys = {
       "name",  "duration",  "rate",   "seed",    "measurements", "lead",    "uavs",
       "noise", "landmarks", "phases", "outages", "estimator",    "control",
-      "variants"};
+      "variants", "world"};
   if (!root.IsMap()) {
     ctx.fail(root.Mark(), "",
              fmt::format("expected a map of scenario settings at the top level, got {}",
@@ -841,6 +964,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   }
   if (auto f = top.get("lead")) parse_lead(ctx, *f, base.lead);
   if (auto f = top.get("uavs")) parse_uavs(ctx, *f, base.uavs, prov);
+  if (auto f = top.get("world")) parse_world(ctx, *f, base.world);
   apply_common(ctx, top, base, prov);
 
   std::vector<Scenario> out;

@@ -86,8 +86,13 @@ inline RunResult run_wingman(const std::vector<std::string>& args, const fs::pat
   cmd += quote(cwd.string());
   cmd += " && ";
   cmd += quote(kBinary.string());
-  for (const auto& a : args) cmd += " " + quote(a);
-  cmd += " > " + quote(log.string()) + " 2>&1";
+  for (const auto& a : args) {
+    cmd += ' ';
+    cmd += quote(a);
+  }
+  cmd += " > ";
+  cmd += quote(log.string());
+  cmd += " 2>&1";
   const int status = std::system(cmd.c_str());
   RunResult r;
   if (status != -1 && WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);

@@ -1,0 +1,232 @@
+// `wingman render`: renders every UAV camera at every step of the open-loop truth and writes an
+// image dataset with depth, sensor samples and ground truth (datasets/dataset.hpp). The dataset
+// is staged next to --out and renamed into place only when complete, so a failed or interrupted
+// run (Ctrl-C included) never leaves a directory that looks finished.
+#include "app/subcommand.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <random>
+
+#include "app/progress.hpp"
+#include "app/version.hpp"
+#include "datasets/dataset.hpp"
+#include "eval/results_dir.hpp"
+#include "geometry/rotation.hpp"
+#include "render/effects.hpp"
+#include "render/gl_context.hpp"
+#include "render/renderer.hpp"
+#include "render/scene.hpp"
+#include "sim/rng.hpp"
+#include "sim/scenario.hpp"
+#include "sim/synthetic_source.hpp"
+#include "sim/truth.hpp"
+
+namespace fs = std::filesystem;
+
+namespace wingman::app {
+
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) { g_interrupted = true; }
+
+// SIGINT/SIGTERM set a flag the frame loop checks; the previous handlers come back on exit.
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    g_interrupted = false;
+    old_int_ = std::signal(SIGINT, on_interrupt);
+    old_term_ = std::signal(SIGTERM, on_interrupt);
+  }
+  ~InterruptGuard() {
+    std::signal(SIGINT, old_int_);
+    std::signal(SIGTERM, old_term_);
+  }
+
+ private:
+  void (*old_int_)(int) = SIG_DFL;
+  void (*old_term_)(int) = SIG_DFL;
+};
+
+struct RenderOptions {
+  std::string scenario;
+  std::string out;
+  std::string gl = "auto";
+  std::optional<std::uint64_t> seed;
+  std::string variant;
+  std::optional<int> frames;
+  std::optional<double> duration;
+  bool gray = false;
+  bool quiet = false;
+};
+
+sim::Scenario pick(const RenderOptions& o) {
+  auto scenarios = sim::load_scenarios(o.scenario);
+  sim::Scenario scn = scenarios.front();
+  if (!o.variant.empty()) {
+    auto it = std::find_if(scenarios.begin(), scenarios.end(),
+                           [&](const sim::Scenario& s) { return s.variant == o.variant; });
+    if (it == scenarios.end()) {
+      std::string known;
+      for (const auto& s : scenarios) known += (known.empty() ? "" : ", ") + s.variant;
+      throw UsageError(fmt::format("{}: no variant '{}' (variants: {})", o.scenario, o.variant,
+                                   known.empty() ? "none" : known));
+    }
+    scn = *it;
+  }
+  if (o.seed) scn.seed = *o.seed;
+  return scn;
+}
+
+// Steps to render (after t = 0): the whole run, or what --frames / --duration keep. The world
+// is always built for the whole run, so a short preview shows exactly the full run's first frames.
+int steps_to_render(const RenderOptions& o, const sim::Scenario& scn) {
+  int n = scn.num_steps();
+  if (o.frames && o.duration) throw UsageError("--frames and --duration exclude each other");
+  if (o.frames) {
+    if (*o.frames < 1) throw UsageError("--frames must be at least 1");
+    n = std::min(n, *o.frames - 1);
+  }
+  if (o.duration) {
+    if (!(*o.duration >= 0)) throw UsageError("--duration must be >= 0");
+    n = std::min(n, static_cast<int>(std::floor(*o.duration * scn.rate + 1e-9)));
+  }
+  return n;
+}
+
+datasets::PoseSample pose(std::int64_t t, const Eigen::Vector3d& p, const Eigen::Matrix3d& R,
+                          const Eigen::Vector3d& v = Eigen::Vector3d::Zero()) {
+  return {t, p, geometry::quaternion_xyzw(R), v};
+}
+
+int render_command(const RenderOptions& o) {
+  render::GlBackend backend;
+  try {
+    backend = render::gl_backend_from_string(o.gl);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  const sim::Scenario scn = pick(o);
+  const int n = steps_to_render(o, scn);
+  const fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);
+
+  render::Scene scene;
+  try {
+    scene = render::build_scene(scn);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(fmt::format("{}: world: {}", o.scenario, e.what()));
+  }
+  std::optional<eval::ResultsDir> staged;
+  try {
+    staged.emplace(out);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(e.what());
+  }
+  const auto ctx = render::create_gl_context(backend);
+  render::Renderer renderer(*ctx, scene);
+  scene = {};  // uploaded; free the CPU copy
+
+  const sim::OpenLoopTruth truth(scn);
+  sim::SyntheticSource sensors(scn, truth);  // same noise streams as a synthetic run
+  auto ahrs_rng = sim::make_stream(scn.seed, "ahrs");
+  std::normal_distribution<double> ahrs_noise(0.0, scn.noise.ahrs_yaw_sigma);
+
+  datasets::DatasetInfo info;
+  info.scenario = scn.name;
+  info.variant = scn.variant;
+  info.seed = scn.seed;
+  info.software_version = kVersion;
+  info.rate = scn.rate;
+  info.renderer = ctx->description();
+  info.agents.push_back("lead");
+  for (const auto& u : scn.uavs) info.agents.push_back(u.name);
+  datasets::DatasetWriter writer(staged->staging(), info);
+  writer.add_agent("lead", std::nullopt);
+  std::vector<render::ImageEffects> effects;
+  for (const auto& u : scn.uavs) {
+    datasets::CameraInfo c;
+    c.camera = u.camera.camera();
+    c.R_CW = truth.commanded_R_CW();
+    c.offset = u.camera.offset;
+    c.rate = scn.rate;
+    c.channels = o.gray ? 1 : 3;
+    writer.add_agent(u.name, c);
+    effects.emplace_back(scn.world.image, scn.seed, u.name);
+  }
+
+  InterruptGuard guard;
+  const int cams = static_cast<int>(scn.uavs.size());
+  ProgressLine progress(fmt::format("[render {}]", scn.name), o.quiet);
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k <= n; ++k) {
+    if (g_interrupted) {
+      progress.finish();
+      fmt::print(stderr, "interrupted: nothing written to {} (staging removed)\n", out.string());
+      return 130;
+    }
+    const double t = k * scn.dt();
+    const std::int64_t t_ns = datasets::step_ns(k, scn.rate);
+    const render::LeadPose lead = render::lead_pose(scn, t);
+    const sim::KinematicState lk = truth.lead(t);
+    writer.ground_truth("lead", pose(t_ns, lk.position, geometry::rot_z(lead.yaw), lk.velocity));
+    if (scn.lead.gps) writer.gps("lead", {t_ns, sensors.gps(t)});
+    const Eigen::Matrix3d R_CW = truth.camera_R_CW(t);
+    for (int j = 0; j < cams; ++j) {
+      const auto& u = scn.uavs[j];
+      const sim::KinematicState q = truth.uav(j, t);
+      const Eigen::Vector3d x_c = truth.camera(j, t).position;
+      render::Frame f = renderer.render({u.camera.camera(), R_CW, x_c}, lead);
+      effects[j].apply(f);
+      writer.write_frame(u.name, t_ns, f.rgb, f.depth);
+      // Open loop: the UAVs keep yaw 0 (their camera's x along world x).
+      writer.ground_truth(u.name, pose(t_ns, q.position, Eigen::Matrix3d::Identity(), q.velocity));
+      writer.camera_pose(u.name, pose(t_ns, x_c, R_CW));
+      if (u.altimeter) writer.altimeter(u.name, {t_ns, sensors.altimeter(j, t)});
+      if (u.range) writer.range(u.name, {t_ns, sensors.range(j, t)});
+      writer.ahrs(u.name, {t_ns, ahrs_noise(ahrs_rng)});
+    }
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    progress.update(k + 1, n + 1,
+                    fmt::format("steps, {:.1f} frames/s", secs > 0 ? (k + 1) * cams / secs : 0.0));
+  }
+  progress.finish();
+  writer.finish();
+  fs::copy_file(o.scenario, staged->staging() / "scenario.yaml");
+  staged->commit();
+  if (!o.quiet)
+    fmt::print("dataset: {} ({} steps x {} cameras, {})\n", out.string(), n + 1, cams,
+               ctx->description());
+  return 0;
+}
+
+}  // namespace
+
+Subcommand add_render(CLI::App& parent) {
+  auto o = std::make_shared<RenderOptions>();
+  auto* cmd = parent.add_subcommand(
+      "render", "Render every UAV camera along the open-loop truth into an image dataset with "
+                "depth, sensor samples and ground truth (EuRoC/ASL layout)");
+  cmd->add_option("scenario", o->scenario, "Scenario YAML file")->required();
+  cmd->add_option("--out,-o", o->out, "Dataset directory (default: datasets/<scenario name>)");
+  cmd->add_option("--gl", o->gl, "OpenGL backend: auto (EGL, then OSMesa), egl or osmesa")
+      ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  cmd->add_option("--seed", o->seed, "Override the scenario's seed");
+  cmd->add_option("--variant", o->variant, "Which variant's settings to use (default: the first)");
+  cmd->add_option("--frames", o->frames, "Render only the first N steps");
+  cmd->add_option("--duration", o->duration, "Render only the first S seconds");
+  cmd->add_flag("--gray", o->gray, "Write 8-bit gray frames instead of RGB");
+  cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
+  return {cmd, [o] { return render_command(*o); }};
+}
+
+}  // namespace wingman::app

@@ -1,0 +1,132 @@
+// The on-disk dataset of DESIGN.md §8, what `wingman render` writes and a replay reads: one
+// folder per agent in the EuRoC/ASL layout,
+//   <agent>/cam0/data/<t_ns>.png, cam0/data.csv, cam0/sensor.yaml   colour (or gray) frames
+//   <agent>/depth0/data/<t_ns>.png, depth0/data.csv, depth0/sensor.yaml   16-bit depth, mm
+//   <agent>/{gps0,altimeter0,range0,ahrs0}/data.csv                  noisy sensor samples
+//   <agent>/groundtruth/data.csv (+ cam0.csv for a UAV: the true camera pose)
+// and a top-level dataset.yaml (format version, scenario, seed, software version). The writer
+// fills a directory the caller stages (app/cmd_render.cpp renames it into place when complete);
+// the reader validates what it loads and names the file at fault.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.hpp"
+
+namespace wingman::datasets {
+
+inline constexpr int kFormatVersion = 1;
+// Depth PNGs hold millimetres; 0 means no surface (sky) or farther than 65.535 m.
+inline constexpr double kDepthScale = 0.001;
+
+class DatasetError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct DatasetInfo {
+  int format_version = kFormatVersion;
+  std::string scenario;  // the scenario's name
+  std::string variant;
+  std::uint64_t seed = 0;
+  std::string software_version;
+  double rate = 10;  // Hz
+  int frames = 0;    // per camera
+  std::string renderer;  // which GL context made the frames
+  std::vector<std::string> agents;
+};
+
+struct CameraInfo {
+  geometry::PinholeCamera camera;
+  Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();  // commanded (the filter's known input)
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();     // camera minus body position
+  double rate = 10;
+  int channels = 3;  // 3: RGB colour, 1: gray
+};
+
+struct PoseSample {  // groundtruth/data.csv (body) and groundtruth/cam0.csv (camera, R_CW)
+  std::int64_t t_ns = 0;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Vector4d q_xyzw{0, 0, 0, 1};
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();  // body only
+};
+
+struct Vec3Sample {
+  std::int64_t t_ns = 0;
+  Eigen::Vector3d value = Eigen::Vector3d::Zero();
+};
+
+struct ScalarSample {
+  std::int64_t t_ns = 0;
+  double value = 0;
+};
+
+struct AgentData {
+  std::string name;
+  std::optional<CameraInfo> camera;     // UAVs
+  std::vector<std::int64_t> frames;     // cam0 and depth0 time stamps
+  std::vector<PoseSample> groundtruth;  // body
+  std::vector<PoseSample> camera_pose;  // true camera pose (with gimbal error)
+  std::vector<Vec3Sample> gps;
+  std::vector<ScalarSample> altimeter, range, ahrs;
+};
+
+struct Dataset {
+  std::filesystem::path root;
+  DatasetInfo info;
+  std::vector<AgentData> agents;
+
+  const AgentData& agent(const std::string& name) const;  // throws DatasetError
+  std::filesystem::path image_path(const std::string& agent, std::int64_t t_ns) const;
+  std::filesystem::path depth_path(const std::string& agent, std::int64_t t_ns) const;
+  // RGB (or gray) CV_8U image and depth in metres (CV_32F, 0 where unknown).
+  cv::Mat load_image(const std::string& agent, std::int64_t t_ns) const;
+  cv::Mat load_depth(const std::string& agent, std::int64_t t_ns) const;
+};
+
+// Time stamp of step k at a rate, in integer nanoseconds.
+std::int64_t step_ns(int k, double rate);
+
+class DatasetWriter {
+ public:
+  // `dir` must exist and be empty (the caller's staging directory).
+  DatasetWriter(std::filesystem::path dir, DatasetInfo info);
+  ~DatasetWriter();
+  // An agent, with a camera for a UAV. Creates its folders.
+  void add_agent(const std::string& name, const std::optional<CameraInfo>& camera);
+  // One frame: colour (RGB, CV_8UC3; written as gray when the camera has 1 channel) and depth in
+  // metres (CV_32F).
+  void write_frame(const std::string& agent, std::int64_t t_ns, const cv::Mat& rgb,
+                   const cv::Mat& depth);
+  void ground_truth(const std::string& agent, const PoseSample& s);
+  void camera_pose(const std::string& agent, const PoseSample& s);
+  void gps(const std::string& agent, const Vec3Sample& s);
+  void altimeter(const std::string& agent, const ScalarSample& s);
+  void range(const std::string& agent, const ScalarSample& s);
+  void ahrs(const std::string& agent, const ScalarSample& s);
+  // Writes the CSVs, the sensor.yaml files and, last, dataset.yaml.
+  void finish();
+
+ private:
+  AgentData& get(const std::string& agent);
+  std::filesystem::path dir_;
+  DatasetInfo info_;
+  std::vector<AgentData> agents_;
+};
+
+// Loads and validates a dataset directory: dataset.yaml with a known format version, every
+// agent's CSVs, every listed frame present with the size sensor.yaml gives (read from the PNG
+// header, so this is fast). Throws DatasetError naming the file.
+Dataset read_dataset(const std::filesystem::path& dir);
+
+}  // namespace wingman::datasets

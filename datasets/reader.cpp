@@ -1,0 +1,268 @@
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <cstring>
+#include <sstream>
+
+#include "datasets/dataset.hpp"
+
+namespace fs = std::filesystem;
+
+namespace wingman::datasets {
+
+namespace {
+
+[[noreturn]] void fail(const fs::path& file, const std::string& what) {
+  throw DatasetError(fmt::format("{}: {}", file.string(), what));
+}
+
+YAML::Node load_yaml(const fs::path& p) {
+  std::error_code ec;
+  if (!fs::is_regular_file(p, ec)) fail(p, "missing");
+  try {
+    return YAML::LoadFile(p.string());
+  } catch (const YAML::Exception& e) {
+    fail(p, fmt::format("not valid YAML: {}", e.what()));
+  }
+}
+
+template <typename T>
+T get(const YAML::Node& n, const fs::path& file, const char* key) {
+  const YAML::Node v = n[key];
+  if (!v) fail(file, fmt::format("missing key '{}'", key));
+  try {
+    return v.as<T>();
+  } catch (const YAML::Exception&) {
+    fail(file, fmt::format("key '{}' has the wrong type", key));
+  }
+}
+
+std::vector<double> numbers(const YAML::Node& n, const fs::path& file, const char* key, std::size_t size) {
+  const auto v = get<std::vector<double>>(n, file, key);
+  if (v.size() != size) fail(file, fmt::format("key '{}' must have {} numbers, has {}", key, size, v.size()));
+  return v;
+}
+
+// CSV rows below the '#' header: each row's comma-separated fields, checked for their count.
+std::vector<std::vector<std::string>> read_csv(const fs::path& p, std::size_t columns) {
+  std::ifstream in(p);
+  if (!in) fail(p, "missing");
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    std::string x;
+    while (std::getline(ss, x, ',')) f.push_back(x);
+    if (f.size() != columns) fail(p, fmt::format("line {}: expected {} columns, got {}", n, columns, f.size()));
+    rows.push_back(std::move(f));
+  }
+  return rows;
+}
+
+double num(const std::string& s, const fs::path& p, std::size_t row) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(s, &used);
+    if (used == s.size()) return v;
+  } catch (const std::exception&) {
+  }
+  fail(p, fmt::format("data row {}: '{}' is not a number", row + 1, s));
+}
+
+std::int64_t stamp(const std::string& s, const fs::path& p, std::size_t row) {
+  try {
+    std::size_t used = 0;
+    const long long v = std::stoll(s, &used);
+    if (used == s.size()) return v;
+  } catch (const std::exception&) {
+  }
+  fail(p, fmt::format("data row {}: '{}' is not a time stamp in ns", row + 1, s));
+}
+
+// Width, height, bit depth and channels from a PNG's IHDR chunk.
+struct PngHeader {
+  int width = 0, height = 0, bit_depth = 0, channels = 0;
+};
+
+PngHeader png_header(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) fail(p, "missing frame");
+  unsigned char b[26];
+  in.read(reinterpret_cast<char*>(b), sizeof b);
+  static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (!in || std::memcmp(b, sig, 8) != 0 || std::memcmp(b + 12, "IHDR", 4) != 0) fail(p, "not a PNG file");
+  auto be32 = [&](int o) { return (b[o] << 24) | (b[o + 1] << 16) | (b[o + 2] << 8) | b[o + 3]; };
+  PngHeader h;
+  h.width = be32(16);
+  h.height = be32(20);
+  h.bit_depth = b[24];
+  switch (b[25]) {
+    case 0: h.channels = 1; break;
+    case 2: h.channels = 3; break;
+    case 4: h.channels = 2; break;
+    case 6: h.channels = 4; break;
+    default: h.channels = 0;
+  }
+  return h;
+}
+
+CameraInfo read_camera(const fs::path& file, double rate_fallback) {
+  const YAML::Node n = load_yaml(file);
+  const auto res = numbers(n, file, "resolution", 2);
+  const auto k = numbers(n, file, "intrinsics", 4);
+  const auto d = numbers(n, file, "distortion_coefficients", 5);
+  const auto r = numbers(n, file, "R_CW", 9);
+  const auto o = numbers(n, file, "offset", 3);
+  if (res[0] < 1 || res[1] < 1) fail(file, "resolution must be positive");
+  CameraInfo c;
+  c.camera = geometry::PinholeCamera(k[0], k[1], k[2], k[3], static_cast<int>(res[0]),
+                                     static_cast<int>(res[1]), {d[0], d[1], d[2], d[3], d[4]});
+  for (int i = 0; i < 9; ++i) c.R_CW(i / 3, i % 3) = r[i];
+  c.offset = {o[0], o[1], o[2]};
+  c.rate = n["rate_hz"] ? get<double>(n, file, "rate_hz") : rate_fallback;
+  c.channels = n["channels"] ? get<int>(n, file, "channels") : 3;
+  if (c.channels != 1 && c.channels != 3) fail(file, fmt::format("channels must be 1 or 3, got {}", c.channels));
+  return c;
+}
+
+std::vector<std::int64_t> read_frames(const fs::path& folder, const CameraInfo& cam, bool depth) {
+  const fs::path csv = folder / "data.csv";
+  std::vector<std::int64_t> out;
+  const auto rows = read_csv(csv, 2);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::int64_t t = stamp(rows[i][0], csv, i);
+    if (!out.empty() && t <= out.back()) fail(csv, fmt::format("data row {}: time stamps must increase", i + 1));
+    const fs::path img = folder / "data" / rows[i][1];
+    std::error_code ec;
+    if (!fs::is_regular_file(img, ec)) fail(img, fmt::format("missing frame (listed in {})", csv.string()));
+    const PngHeader h = png_header(img);
+    if (h.width != cam.camera.width() || h.height != cam.camera.height())
+      fail(img, fmt::format("image is {}x{}, sensor.yaml says {}x{}", h.width, h.height,
+                            cam.camera.width(), cam.camera.height()));
+    if (depth && (h.bit_depth != 16 || h.channels != 1))
+      fail(img, "depth frames must be 16-bit single-channel PNG");
+    if (!depth && (h.bit_depth != 8 || h.channels != cam.channels))
+      fail(img, fmt::format("expected an 8-bit image with {} channel(s), got {}-bit with {}",
+                            cam.channels, h.bit_depth, h.channels));
+    out.push_back(t);
+  }
+  return out;
+}
+
+std::vector<PoseSample> read_poses(const fs::path& csv, bool velocity) {
+  std::vector<PoseSample> out;
+  const auto rows = read_csv(csv, velocity ? 11 : 8);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    PoseSample s;
+    s.t_ns = stamp(r[0], csv, i);
+    s.p = {num(r[1], csv, i), num(r[2], csv, i), num(r[3], csv, i)};
+    s.q_xyzw = {num(r[5], csv, i), num(r[6], csv, i), num(r[7], csv, i), num(r[4], csv, i)};
+    if (velocity) s.v = {num(r[8], csv, i), num(r[9], csv, i), num(r[10], csv, i)};
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::vector<ScalarSample> read_scalars(const fs::path& csv) {
+  std::vector<ScalarSample> out;
+  const auto rows = read_csv(csv, 2);
+  for (std::size_t i = 0; i < rows.size(); ++i) out.push_back({stamp(rows[i][0], csv, i), num(rows[i][1], csv, i)});
+  return out;
+}
+
+}  // namespace
+
+const AgentData& Dataset::agent(const std::string& name) const {
+  for (const auto& a : agents)
+    if (a.name == name) return a;
+  throw DatasetError(fmt::format("{}: no agent '{}'", (root / "dataset.yaml").string(), name));
+}
+
+fs::path Dataset::image_path(const std::string& a, std::int64_t t) const {
+  return root / a / "cam0" / "data" / fmt::format("{}.png", t);
+}
+fs::path Dataset::depth_path(const std::string& a, std::int64_t t) const {
+  return root / a / "depth0" / "data" / fmt::format("{}.png", t);
+}
+
+cv::Mat Dataset::load_image(const std::string& a, std::int64_t t) const {
+  const fs::path p = image_path(a, t);
+  cv::Mat img = cv::imread(p.string(), cv::IMREAD_UNCHANGED);
+  if (img.empty()) fail(p, "cannot read image");
+  if (img.channels() == 3) cv::cvtColor(img, img, cv::COLOR_BGR2RGB);
+  return img;
+}
+
+cv::Mat Dataset::load_depth(const std::string& a, std::int64_t t) const {
+  const fs::path p = depth_path(a, t);
+  cv::Mat mm = cv::imread(p.string(), cv::IMREAD_UNCHANGED);
+  if (mm.empty() || mm.type() != CV_16UC1) fail(p, "cannot read a 16-bit depth image");
+  cv::Mat m;
+  mm.convertTo(m, CV_32F, kDepthScale);
+  return m;
+}
+
+Dataset read_dataset(const fs::path& dir) {
+  Dataset ds;
+  ds.root = dir;
+  const fs::path yf = dir / "dataset.yaml";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) fail(dir, "not a directory");
+  if (!fs::is_regular_file(yf, ec))
+    fail(yf, "missing: not a wingman dataset, or an unfinished one");
+  const YAML::Node y = load_yaml(yf);
+  if (!y.IsMap()) fail(yf, "expected a map");
+  if (get<std::string>(y, yf, "format") != "wingman-dataset") fail(yf, "format is not 'wingman-dataset'");
+  ds.info.format_version = get<int>(y, yf, "format_version");
+  if (ds.info.format_version != kFormatVersion)
+    fail(yf, fmt::format("unknown format_version {} (this wingman reads version {})",
+                         ds.info.format_version, kFormatVersion));
+  ds.info.scenario = get<std::string>(y, yf, "scenario");
+  ds.info.variant = y["variant"] && !y["variant"].IsNull() ? get<std::string>(y, yf, "variant") : "";
+  ds.info.seed = get<std::uint64_t>(y, yf, "seed");
+  ds.info.software_version = get<std::string>(y, yf, "software_version");
+  ds.info.rate = get<double>(y, yf, "rate_hz");
+  ds.info.frames = get<int>(y, yf, "frames");
+  ds.info.renderer = y["renderer"] ? get<std::string>(y, yf, "renderer") : "";
+  ds.info.agents = get<std::vector<std::string>>(y, yf, "agents");
+  for (const auto& name : ds.info.agents) {
+    AgentData a;
+    a.name = name;
+    const fs::path ad = dir / name;
+    if (!fs::is_directory(ad, ec)) fail(ad, "missing agent folder (listed in dataset.yaml)");
+    a.groundtruth = read_poses(ad / "groundtruth" / "data.csv", true);
+    if (fs::exists(ad / "cam0", ec)) {
+      a.camera = read_camera(ad / "cam0" / "sensor.yaml", ds.info.rate);
+      a.frames = read_frames(ad / "cam0", *a.camera, false);
+      const auto depth = read_frames(ad / "depth0", *a.camera, true);
+      if (depth != a.frames)
+        fail(ad / "depth0" / "data.csv", "its time stamps differ from cam0/data.csv");
+      if (static_cast<int>(a.frames.size()) != ds.info.frames)
+        fail(ad / "cam0" / "data.csv", fmt::format("lists {} frames, dataset.yaml says {}",
+                                                   a.frames.size(), ds.info.frames));
+      a.camera_pose = read_poses(ad / "groundtruth" / "cam0.csv", false);
+    }
+    if (fs::exists(ad / "gps0", ec)) {
+      const fs::path csv = ad / "gps0" / "data.csv";
+      const auto rows = read_csv(csv, 4);
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        a.gps.push_back({stamp(rows[i][0], csv, i),
+                         {num(rows[i][1], csv, i), num(rows[i][2], csv, i), num(rows[i][3], csv, i)}});
+    }
+    if (fs::exists(ad / "altimeter0", ec)) a.altimeter = read_scalars(ad / "altimeter0" / "data.csv");
+    if (fs::exists(ad / "range0", ec)) a.range = read_scalars(ad / "range0" / "data.csv");
+    if (fs::exists(ad / "ahrs0", ec)) a.ahrs = read_scalars(ad / "ahrs0" / "data.csv");
+    ds.agents.push_back(std::move(a));
+  }
+  return ds;
+}
+
+}  // namespace wingman::datasets

@@ -1,0 +1,519 @@
+#include "render/renderer.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "render/gl_functions.hpp"
+
+namespace wingman::render {
+
+namespace {
+
+const char* kSceneVs = R"(#version 330 core
+layout(location = 0) in vec3 a_pos;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in vec3 a_colour;
+uniform mat4 u_model_view;
+uniform mat4 u_proj;
+uniform mat3 u_model_rot;
+out vec3 v_normal;
+out vec2 v_uv;
+out vec3 v_colour;
+out float v_depth;
+void main() {
+  vec4 pc = u_model_view * vec4(a_pos, 1.0);
+  v_depth = pc.z;
+  v_normal = u_model_rot * a_normal;
+  v_uv = a_uv;
+  v_colour = a_colour;
+  gl_Position = u_proj * pc;
+}
+)";
+
+const char* kSceneFs = R"(#version 330 core
+in vec3 v_normal;
+in vec2 v_uv;
+in vec3 v_colour;
+in float v_depth;
+uniform sampler2D u_tex;
+uniform vec3 u_to_light;
+uniform float u_ambient;
+uniform float u_diffuse;
+uniform int u_unlit;
+layout(location = 0) out vec4 o_colour;
+layout(location = 1) out float o_depth;
+void main() {
+  vec3 albedo = texture(u_tex, v_uv).rgb * v_colour;
+  float shade = u_unlit != 0 ? 1.0
+      : u_ambient + u_diffuse * max(dot(normalize(v_normal), u_to_light), 0.0);
+  o_colour = vec4(albedo * shade, 1.0);
+  o_depth = v_depth;
+}
+)";
+
+// MSAA resolve: colour averaged over the samples; depth from sample 0, which the fragment shader
+// evaluated at the pixel centre (no per-sample shading), so depth never blends two surfaces.
+const char* kResolveVs = R"(#version 330 core
+void main() {
+  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* kResolveFs = R"(#version 330 core
+uniform sampler2DMS u_colour;
+uniform sampler2DMS u_depth;
+uniform int u_samples;
+layout(location = 0) out vec4 o_colour;
+layout(location = 1) out float o_depth;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  vec4 c = vec4(0.0);
+  for (int i = 0; i < u_samples; ++i) c += texelFetch(u_colour, p, i);
+  o_colour = c / float(u_samples);
+  o_depth = texelFetch(u_depth, p, 0).r;
+}
+)";
+
+struct GpuMesh {
+  GLuint vao = 0, vbo = 0, ebo = 0;
+  GLsizei count = 0;
+  int material = -1;
+};
+
+struct GpuMaterial {
+  GLuint tex = 0;
+  bool unlit = false;
+};
+
+struct Target {
+  int w = 0, h = 0, samples = 1;
+  GLuint ms_fbo = 0, ms_colour = 0, ms_depthval = 0, ms_depth = 0;
+  GLuint fbo = 0, colour = 0, depthval = 0, depth = 0;
+  cv::Mat rgba;  // readback buffers, reused
+};
+
+Eigen::Matrix4f to_float(const Eigen::Matrix4d& m) { return m.cast<float>(); }
+
+}  // namespace
+
+cv::Mat Frame::gray() const {
+  cv::Mat g;
+  cv::cvtColor(rgb, g, cv::COLOR_RGB2GRAY);
+  return g;
+}
+
+struct Renderer::Impl {
+  GlFunctions gl;
+  GLuint program = 0, resolve_program = 0, empty_vao = 0, white = 0;
+  GLint u_model_view = -1, u_proj = -1, u_model_rot = -1, u_tex = -1, u_to_light = -1,
+        u_ambient = -1, u_diffuse = -1, u_unlit = -1;
+  GLint r_colour = -1, r_depth = -1, r_samples = -1;
+  std::vector<GpuMaterial> materials;
+  std::vector<GpuMesh> static_meshes, lead_meshes;
+  std::map<std::pair<int, int>, Target> targets;
+  Scene info;  // light, sky, near, far, msaa (meshes cleared)
+  float max_aniso = 1;
+
+  GLuint compile(GLenum type, const char* src) {
+    GLuint s = gl.CreateShader(type);
+    gl.ShaderSource(s, 1, &src, nullptr);
+    gl.CompileShader(s);
+    GLint ok = 0;
+    gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      char log[4096];
+      gl.GetShaderInfoLog(s, sizeof log, nullptr, log);
+      throw std::runtime_error(std::string("renderer: shader compile failed: ") + log);
+    }
+    return s;
+  }
+  GLuint link(const char* vs, const char* fs) {
+    GLuint p = gl.CreateProgram();
+    GLuint a = compile(GL_VERTEX_SHADER, vs), b = compile(GL_FRAGMENT_SHADER, fs);
+    gl.AttachShader(p, a);
+    gl.AttachShader(p, b);
+    gl.LinkProgram(p);
+    gl.DeleteShader(a);
+    gl.DeleteShader(b);
+    GLint ok = 0;
+    gl.GetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+      char log[4096];
+      gl.GetProgramInfoLog(p, sizeof log, nullptr, log);
+      throw std::runtime_error(std::string("renderer: shader link failed: ") + log);
+    }
+    return p;
+  }
+
+  GLuint upload_texture(const cv::Mat& img, bool repeat, bool mipmaps, double anisotropy) {
+    cv::Mat rgba;
+    if (img.channels() == 3)
+      cv::cvtColor(img, rgba, cv::COLOR_RGB2RGBA);
+    else if (img.channels() == 4)
+      rgba = img;
+    else
+      cv::cvtColor(img, rgba, cv::COLOR_GRAY2RGBA);
+    if (!rgba.isContinuous()) rgba = rgba.clone();
+    GLuint t = 0;
+    gl.GenTextures(1, &t);
+    gl.BindTexture(GL_TEXTURE_2D, t);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rgba.cols, rgba.rows, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                  rgba.data);
+    const GLint wrap = repeat ? GL_REPEAT : GL_CLAMP_TO_EDGE;
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    if (mipmaps) {
+      gl.GenerateMipmap(GL_TEXTURE_2D);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      if (max_aniso > 1 && anisotropy > 1)
+        gl.TexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY,
+                         std::min<float>(max_aniso, static_cast<float>(anisotropy)));
+    } else {
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    }
+    return t;
+  }
+
+  GpuMesh upload_mesh(const Mesh& m) {
+    GpuMesh g;
+    g.material = m.material;
+    g.count = static_cast<GLsizei>(m.indices.size());
+    const std::size_t n = m.vertex_count();
+    std::vector<float> v;
+    v.reserve(n * 11);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int k = 0; k < 3; ++k) v.push_back(m.positions[3 * i + k]);
+      for (int k = 0; k < 3; ++k) v.push_back(m.normals[3 * i + k]);
+      for (int k = 0; k < 2; ++k) v.push_back(m.uvs[2 * i + k]);
+      for (int k = 0; k < 3; ++k) v.push_back(m.colours[3 * i + k]);
+    }
+    gl.GenVertexArrays(1, &g.vao);
+    gl.BindVertexArray(g.vao);
+    gl.GenBuffers(1, &g.vbo);
+    gl.BindBuffer(GL_ARRAY_BUFFER, g.vbo);
+    gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(),
+                  GL_STATIC_DRAW);
+    gl.GenBuffers(1, &g.ebo);
+    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
+    gl.BufferData(GL_ELEMENT_ARRAY_BUFFER,
+                  static_cast<GLsizeiptr>(m.indices.size() * sizeof(std::uint32_t)),
+                  m.indices.data(), GL_STATIC_DRAW);
+    const GLsizei stride = 11 * sizeof(float);
+    const int sizes[4] = {3, 3, 2, 3};
+    std::size_t off = 0;
+    for (GLuint a = 0; a < 4; ++a) {
+      gl.EnableVertexAttribArray(a);
+      gl.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
+                             reinterpret_cast<const void*>(off * sizeof(float)));
+      off += sizes[a];
+    }
+    gl.BindVertexArray(0);
+    return g;
+  }
+
+  void check_fbo(const char* what) {
+    const GLenum s = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (s != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error(std::string("renderer: ") + what +
+                               " framebuffer incomplete (status 0x" + std::to_string(s) + ")");
+  }
+
+  Target& target(int w, int h) {
+    auto it = targets.find({w, h});
+    if (it != targets.end()) return it->second;
+    Target t;
+    t.w = w;
+    t.h = h;
+    GLint max_samples = 1;
+    gl.GetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    t.samples = std::max(1, std::min(info.msaa, static_cast<int>(max_samples)));
+    auto tex2d = [&](GLenum internal, GLenum format, GLenum type) {
+      GLuint x = 0;
+      gl.GenTextures(1, &x);
+      gl.BindTexture(GL_TEXTURE_2D, x);
+      gl.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), w, h, 0, format, type, nullptr);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      return x;
+    };
+    const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    gl.GenFramebuffers(1, &t.fbo);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+    t.colour = tex2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE);
+    t.depthval = tex2d(GL_R32F, GL_RED, GL_FLOAT);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.colour, 0);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, t.depthval, 0);
+    if (t.samples == 1) {
+      gl.GenRenderbuffers(1, &t.depth);
+      gl.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
+      gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, w, h);
+      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
+    }
+    gl.DrawBuffers(2, bufs);
+    check_fbo("resolve");
+    if (t.samples > 1) {
+      gl.GenFramebuffers(1, &t.ms_fbo);
+      gl.BindFramebuffer(GL_FRAMEBUFFER, t.ms_fbo);
+      auto texms = [&](GLenum internal) {
+        GLuint x = 0;
+        gl.GenTextures(1, &x);
+        gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, x);
+        gl.TexImage2DMultisample(GL_TEXTURE_2D_MULTISAMPLE, t.samples, internal, w, h, GL_TRUE);
+        return x;
+      };
+      t.ms_colour = texms(GL_RGBA8);
+      t.ms_depthval = texms(GL_R32F);
+      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D_MULTISAMPLE,
+                              t.ms_colour, 0);
+      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D_MULTISAMPLE,
+                              t.ms_depthval, 0);
+      gl.GenRenderbuffers(1, &t.ms_depth);
+      gl.BindRenderbuffer(GL_RENDERBUFFER, t.ms_depth);
+      gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, t.samples, GL_DEPTH_COMPONENT32F, w, h);
+      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.ms_depth);
+      gl.DrawBuffers(2, bufs);
+      check_fbo("multisample");
+    }
+    t.rgba.create(h, w, CV_8UC4);
+    return targets.emplace(std::make_pair(w, h), std::move(t)).first->second;
+  }
+
+  void release() {
+    for (auto& [k, t] : targets) {
+      GLuint fbos[2] = {t.fbo, t.ms_fbo};
+      GLuint texs[4] = {t.colour, t.depthval, t.ms_colour, t.ms_depthval};
+      GLuint rbs[2] = {t.depth, t.ms_depth};
+      gl.DeleteFramebuffers(2, fbos);
+      gl.DeleteTextures(4, texs);
+      gl.DeleteRenderbuffers(2, rbs);
+    }
+    for (auto* list : {&static_meshes, &lead_meshes})
+      for (auto& m : *list) {
+        gl.DeleteVertexArrays(1, &m.vao);
+        gl.DeleteBuffers(1, &m.vbo);
+        gl.DeleteBuffers(1, &m.ebo);
+      }
+    for (auto& m : materials) gl.DeleteTextures(1, &m.tex);
+    gl.DeleteTextures(1, &white);
+    gl.DeleteVertexArrays(1, &empty_vao);
+    gl.DeleteProgram(program);
+    gl.DeleteProgram(resolve_program);
+  }
+};
+
+Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::make_unique<Impl>()) {
+  ctx_.make_current();
+  Impl& I = *impl_;
+  I.gl.load(ctx_);
+  auto& gl = I.gl;
+  while (gl.GetError() != GL_NO_ERROR) {
+  }
+  gl.GetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &I.max_aniso);
+  if (gl.GetError() != GL_NO_ERROR) I.max_aniso = 1;  // no anisotropic filtering here
+  I.info.light = scene.light;
+  I.info.sky = scene.sky;
+  I.info.near = scene.near;
+  I.info.far = scene.far;
+  I.info.msaa = scene.msaa;
+  I.program = I.link(kSceneVs, kSceneFs);
+  I.resolve_program = I.link(kResolveVs, kResolveFs);
+  I.u_model_view = gl.GetUniformLocation(I.program, "u_model_view");
+  I.u_proj = gl.GetUniformLocation(I.program, "u_proj");
+  I.u_model_rot = gl.GetUniformLocation(I.program, "u_model_rot");
+  I.u_tex = gl.GetUniformLocation(I.program, "u_tex");
+  I.u_to_light = gl.GetUniformLocation(I.program, "u_to_light");
+  I.u_ambient = gl.GetUniformLocation(I.program, "u_ambient");
+  I.u_diffuse = gl.GetUniformLocation(I.program, "u_diffuse");
+  I.u_unlit = gl.GetUniformLocation(I.program, "u_unlit");
+  I.r_colour = gl.GetUniformLocation(I.resolve_program, "u_colour");
+  I.r_depth = gl.GetUniformLocation(I.resolve_program, "u_depth");
+  I.r_samples = gl.GetUniformLocation(I.resolve_program, "u_samples");
+  gl.GenVertexArrays(1, &I.empty_vao);
+  I.white = I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, 1);
+  for (const auto& m : scene.materials) {
+    GpuMaterial g;
+    g.tex = m.texture.empty() ? 0 : I.upload_texture(m.texture, m.repeat, m.mipmaps, m.anisotropy);
+    g.unlit = m.unlit;
+    I.materials.push_back(g);
+  }
+  for (const auto& m : scene.static_meshes)
+    if (!m.indices.empty()) I.static_meshes.push_back(I.upload_mesh(m));
+  for (const auto& m : scene.lead_meshes)
+    if (!m.indices.empty()) I.lead_meshes.push_back(I.upload_mesh(m));
+  if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
+    throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while uploading the scene");
+}
+
+Renderer::~Renderer() {
+  try {
+    ctx_.make_current();
+    impl_->release();
+  } catch (...) {
+    // The context is going away with us anyway.
+  }
+}
+
+Eigen::Matrix4d Renderer::projection(double fx, double fy, double cx, double cy, int w, int h,
+                                     double n, double f) {
+  // Clip w = z (OpenCV camera looks along +z). Window x = u + 0.5 puts u = fx x/z + cx at the
+  // centre of pixel column u; window y = v + 0.5 makes GL's row 0 the image's top row.
+  Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
+  P(0, 0) = 2 * fx / w;
+  P(0, 2) = 2 * (cx + 0.5) / w - 1;
+  P(1, 1) = 2 * fy / h;
+  P(1, 2) = 2 * (cy + 0.5) / h - 1;
+  P(2, 2) = (f + n) / (f - n);
+  P(2, 3) = -2 * f * n / (f - n);
+  P(3, 2) = 1;
+  return P;
+}
+
+Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w, int h,
+                               const CameraView& view, const std::optional<LeadPose>& lead) {
+  ctx_.make_current();
+  Impl& I = *impl_;
+  auto& gl = I.gl;
+  Target& t = I.target(w, h);
+  const Eigen::Matrix4f P = to_float(projection(fx, fy, cx, cy, w, h, I.info.near, I.info.far));
+  Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
+  V.topLeftCorner<3, 3>() = view.R_CW;
+  V.topRightCorner<3, 1>() = -view.R_CW * view.x_c;
+
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.samples > 1 ? t.ms_fbo : t.fbo);
+  gl.Viewport(0, 0, w, h);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_LESS);
+  gl.Disable(GL_CULL_FACE);  // the y-flipped projection mirrors the winding; draw both faces
+  if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
+  const float sky[4] = {static_cast<float>(I.info.sky.x()), static_cast<float>(I.info.sky.y()),
+                        static_cast<float>(I.info.sky.z()), 1.f};
+  const float zero[4] = {0, 0, 0, 0};
+  const float one = 1.f;
+  gl.ClearBufferfv(GL_COLOR, 0, sky);
+  gl.ClearBufferfv(GL_COLOR, 1, zero);
+  gl.ClearBufferfv(GL_DEPTH, 0, &one);
+
+  gl.UseProgram(I.program);
+  gl.UniformMatrix4fv(I.u_proj, 1, GL_FALSE, P.data());
+  const Eigen::Vector3f to_light = (-I.info.light.direction.normalized()).cast<float>();
+  gl.Uniform3fv(I.u_to_light, 1, to_light.data());
+  gl.Uniform1f(I.u_ambient, static_cast<float>(I.info.light.ambient));
+  gl.Uniform1f(I.u_diffuse, static_cast<float>(I.info.light.diffuse));
+  gl.Uniform1i(I.u_tex, 0);
+  gl.ActiveTexture(GL_TEXTURE0);
+
+  auto draw = [&](const std::vector<GpuMesh>& meshes, const Eigen::Matrix4d& M) {
+    const Eigen::Matrix4f MV = to_float(V * M);
+    const Eigen::Matrix3f R = M.topLeftCorner<3, 3>().cast<float>();
+    gl.UniformMatrix4fv(I.u_model_view, 1, GL_FALSE, MV.data());
+    gl.UniformMatrix3fv(I.u_model_rot, 1, GL_FALSE, R.data());
+    for (const auto& m : meshes) {
+      const GpuMaterial* mat = m.material >= 0 ? &I.materials[m.material] : nullptr;
+      gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : I.white);
+      gl.Uniform1i(I.u_unlit, mat && mat->unlit ? 1 : 0);
+      gl.BindVertexArray(m.vao);
+      gl.DrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
+    }
+  };
+  draw(I.static_meshes, Eigen::Matrix4d::Identity());
+  if (lead && !I.lead_meshes.empty()) {
+    Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
+    const double c = std::cos(lead->yaw), s = std::sin(lead->yaw);
+    M.topLeftCorner<3, 3>() << c, -s, 0, s, c, 0, 0, 0, 1;
+    M.topRightCorner<3, 1>() = lead->position;
+    draw(I.lead_meshes, M);
+  }
+
+  if (t.samples > 1) {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.UseProgram(I.resolve_program);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_colour);
+    gl.ActiveTexture(GL_TEXTURE1);
+    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_depthval);
+    gl.Uniform1i(I.r_colour, 0);
+    gl.Uniform1i(I.r_depth, 1);
+    gl.Uniform1i(I.r_samples, t.samples);
+    gl.BindVertexArray(I.empty_vao);
+    gl.DrawArrays(GL_TRIANGLES, 0, 3);
+    gl.ActiveTexture(GL_TEXTURE0);
+  }
+  gl.BindVertexArray(0);
+
+  Frame f;
+  f.depth.create(h, w, CV_32F);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, t.rgba.data);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
+  gl.ReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, f.depth.data);
+  cv::cvtColor(t.rgba, f.rgb, cv::COLOR_RGBA2RGB);
+  if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
+    throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while rendering");
+  return f;
+}
+
+// Remap tables from the distorted image to a wider pinhole canvas.
+struct Renderer::Undistort {
+  double cx = 0, cy = 0;  // principal point on the canvas
+  int w = 0, h = 0;       // canvas size
+  cv::Mat map1, map2;     // fixed-point maps for cv::remap (bilinear)
+  cv::Mat nearest_x, nearest_y;  // float maps for depth (nearest)
+};
+
+Frame Renderer::render(const CameraView& view, const std::optional<LeadPose>& lead) {
+  const auto& cam = view.camera;
+  if (cam.distortion().is_zero())
+    return render_pinhole(cam.fx(), cam.fy(), cam.cx(), cam.cy(), cam.width(), cam.height(), view,
+                          lead);
+  const auto& d = cam.distortion();
+  const auto key = std::make_tuple(cam.fx(), cam.fy(), cam.cx(), cam.cy(), cam.width(),
+                                   cam.height(), d.k1, d.k2, d.p1, d.p2, d.k3);
+  auto& u = undistort_[key];
+  if (!u) {
+    u = std::make_shared<Undistort>();
+    cv::Mat mx(cam.height(), cam.width(), CV_32F), my(cam.height(), cam.width(), CV_32F);
+    double umin = 0, umax = cam.width() - 1, vmin = 0, vmax = cam.height() - 1;
+    for (int r = 0; r < cam.height(); ++r)
+      for (int c = 0; c < cam.width(); ++c) {
+        const Eigen::Vector2d xn = cam.unproject_normalised(Eigen::Vector2d(c, r));
+        const double pu = cam.fx() * xn.x() + cam.cx(), pv = cam.fy() * xn.y() + cam.cy();
+        mx.at<float>(r, c) = static_cast<float>(pu);
+        my.at<float>(r, c) = static_cast<float>(pv);
+        umin = std::min(umin, pu), umax = std::max(umax, pu);
+        vmin = std::min(vmin, pv), vmax = std::max(vmax, pv);
+      }
+    // Canvas covering every pixel the distorted image samples (at most 3x the image).
+    umin = std::max(std::floor(umin) - 2, -1.0 * cam.width());
+    vmin = std::max(std::floor(vmin) - 2, -1.0 * cam.height());
+    umax = std::min(std::ceil(umax) + 2, 2.0 * cam.width());
+    vmax = std::min(std::ceil(vmax) + 2, 2.0 * cam.height());
+    u->w = static_cast<int>(umax - umin) + 1;
+    u->h = static_cast<int>(vmax - vmin) + 1;
+    u->cx = cam.cx() - umin;
+    u->cy = cam.cy() - vmin;
+    mx -= static_cast<float>(umin);
+    my -= static_cast<float>(vmin);
+    u->nearest_x = mx;
+    u->nearest_y = my;
+    cv::convertMaps(mx, my, u->map1, u->map2, CV_16SC2);
+  }
+  const Frame wide = render_pinhole(cam.fx(), cam.fy(), u->cx, u->cy, u->w, u->h, view, lead);
+  Frame f;
+  cv::remap(wide.rgb, f.rgb, u->map1, u->map2, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::remap(wide.depth, f.depth, u->nearest_x, u->nearest_y, cv::INTER_NEAREST,
+            cv::BORDER_CONSTANT);
+  return f;
+}
+
+}  // namespace wingman::render

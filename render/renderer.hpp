@@ -1,0 +1,65 @@
+// The off-screen renderer: draws a Scene from any number of pinhole cameras and reads back
+// colour (RGB8) and metric depth (float metres along the optical axis, 0 where nothing was hit).
+// Pixels obey DESIGN.md §2 exactly: the projection puts u = fx x/z + cx at the centre of pixel
+// column u (OpenCV's convention), and GL's bottom row is rendered as image row 0, so readback
+// needs no flip. Radial-tangential distortion, when the camera has it, is applied by cv::remap
+// from a wider pinhole render with maps computed once per camera. Every GL object (buffers,
+// textures, framebuffers per image size) is made once; a frame creates none.
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <tuple>
+
+#include "geometry/camera.hpp"
+#include "render/gl_context.hpp"
+#include "render/scene.hpp"
+
+namespace wingman::render {
+
+struct CameraView {
+  geometry::PinholeCamera camera;
+  Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d x_c = Eigen::Vector3d::Zero();  // camera centre, world frame
+};
+
+struct Frame {
+  cv::Mat rgb;    // CV_8UC3, RGB order
+  cv::Mat depth;  // CV_32FC1, metres along the optical axis; 0: no surface
+  cv::Mat gray() const;  // CV_8UC1
+};
+
+class Renderer {
+ public:
+  // Uploads the scene into the context (which must outlive the renderer).
+  Renderer(GlContext& ctx, const Scene& scene);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  Frame render(const CameraView& view, const std::optional<LeadPose>& lead = std::nullopt);
+  const GlContext& context() const { return ctx_; }
+
+  // The OpenGL projection matrix for an undistorted w x h image with these intrinsics
+  // (camera frame: OpenCV's; exposed for tests).
+  static Eigen::Matrix4d projection(double fx, double fy, double cx, double cy, int w, int h,
+                                    double near, double far);
+
+ private:
+  struct Impl;
+  struct Undistort;
+  Frame render_pinhole(double fx, double fy, double cx, double cy, int w, int h,
+                       const CameraView& view, const std::optional<LeadPose>& lead);
+  GlContext& ctx_;
+  std::unique_ptr<Impl> impl_;
+  std::map<std::tuple<double, double, double, double, int, int, double, double, double, double,
+                      double>,
+           std::shared_ptr<Undistort>>
+      undistort_;
+};
+
+}  // namespace wingman::render

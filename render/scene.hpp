@@ -1,0 +1,72 @@
+// What the renderer draws, on the CPU side: meshes with per-vertex colour and one material each,
+// textures as images, light and sky. build_scene() makes it from a scenario's world section
+// (terrain, its texture, scattered objects, the lead's assimp model with its roof cue); tests
+// build small scenes by hand. Uploaded once to the GPU by Renderer.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "sim/scenario.hpp"
+
+namespace wingman::render {
+
+struct Material {
+  cv::Mat texture;  // CV_8UC3 or CV_8UC4, RGB(A) order, row 0 at t = 0; empty: plain white
+  bool repeat = true;
+  bool mipmaps = true;
+  double anisotropy = 4;
+  bool unlit = false;  // colour shown as is (markers, test targets)
+};
+
+struct Mesh {
+  std::vector<float> positions;  // xyz per vertex
+  std::vector<float> normals;    // xyz per vertex
+  std::vector<float> uvs;        // st per vertex
+  std::vector<float> colours;    // rgb per vertex, multiplies the texture
+  std::vector<std::uint32_t> indices;
+  int material = -1;  // index into Scene::materials, -1: untextured
+
+  std::size_t vertex_count() const { return positions.size() / 3; }
+  // Appends one vertex.
+  void add(const Eigen::Vector3d& p, const Eigen::Vector3d& n, const Eigen::Vector2d& uv,
+           const Eigen::Vector3d& colour);
+  // Appends another mesh's triangles (same material).
+  void append(const Mesh& m);
+};
+
+struct Scene {
+  std::vector<Material> materials;
+  std::vector<Mesh> static_meshes;  // world frame
+  std::vector<Mesh> lead_meshes;    // lead frame: origin at its reference point, x forward, z up
+  sim::LightSpec light{};
+  Eigen::Vector3d sky{0.62, 0.74, 0.88};
+  double near = 0.1, far = 1000;
+  int msaa = 4;
+};
+
+// Pose of the lead's reference point: position in the world and heading about world z.
+struct LeadPose {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double yaw = 0;
+};
+
+// A relative asset path against the scenario file's directory, then the repository's assets/.
+// Absolute paths are used as they are. Throws std::runtime_error naming every place looked at.
+std::string resolve_asset(const std::string& path, const std::string& scenario_path,
+                          const std::string& what);
+
+// The lead model from any format assimp reads, scaled to `height`, its up axis made z, its
+// top-centre moved to the origin; with the cue on its roof. Throws std::runtime_error naming the
+// file when it is missing, not a model, or refers to a missing texture.
+void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, Scene& scene);
+
+// The whole world of a scenario.
+Scene build_scene(const sim::Scenario& scn);
+
+// The lead's pose at t (heading from its velocity).
+LeadPose lead_pose(const sim::Scenario& scn, double t);
+
+}  // namespace wingman::render

@@ -1,0 +1,131 @@
+// The rendered world of a scenario (`world:` section, docs/rendering.md): terrain, its texture,
+// scattered objects, the lead's model and its visual cue, light and image effects. The spec is
+// plain data; TerrainModel and scatter_objects() turn it into heights and object placements that
+// the renderer draws and anyone else (tests, a replay) can query without a GL context.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace wingman::sim {
+
+struct Scenario;
+class OpenLoopTruth;
+
+struct TerrainSpec {
+  double extent = 0;          // m, side of the square terrain; 0: the flight's extent plus margin
+  double margin = 60;         // m around the flight when extent is 0 (a nadir camera at 17 m sees +-42 m)
+  double mean_height = 0;     // m (an aerial lead; around a ground lead the land follows its road)
+  double relief = 1.5;        // m, peak amplitude of the seeded undulation
+  double relief_scale = 40;   // m, wavelength of the largest undulation
+  double resolution = 2;      // m between mesh vertices
+  double road_half_width = 3;  // m of flat ground under a ground lead's path
+  double road_blend = 8;       // m over which the terrain returns to its own relief
+};
+
+struct TextureSpec {
+  enum class Type { Image, Procedural };
+  enum class Mode { Tiled, Stretched };
+  Type type = Type::Image;
+  std::string image = "aerial/freetown_drone_nadir.jpg";  // scenario dir, then assets/
+  Mode mode = Mode::Tiled;
+  double tile_size = 60;     // m covered by one copy of the image (tiled)
+  double detail_min = 0.02;  // m, finest and coarsest detail of the procedural texture
+  double detail_max = 0.2;
+  int size = 2048;           // px of the procedural texture (one tile, detail_min per texel)
+  // Max anisotropic filtering; 1 disables it. A nadir camera with the paper's 136 deg field of
+  // view sees the ground at most 68 deg off-axis, an anisotropy of about 2.7: 4 is enough.
+  double anisotropy = 4;
+};
+
+struct ObjectsSpec {
+  double boulders = 25;   // per hectare
+  double trees = 12;
+  double buildings = 2;
+  double clearance = 8;   // m kept free on both sides of the lead's path
+};
+
+struct LeadModelSpec {
+  enum class Kind { Ground, Aerial };
+  enum class Cue { Aruco, Panel, None };
+  std::string model = "models/cesium_milk_truck/CesiumMilkTruck.glb";
+  Kind kind = Kind::Ground;  // ground: the terrain follows the lead's height along its path
+  double height = 2.6;       // m, the model is scaled to this height
+  std::string up = "y";      // the model's up axis: y (glTF) or z (Blender, CAD)
+  double yaw_offset = 0;     // rad, added to the heading so the model's front points forward
+  Cue cue = Cue::Aruco;
+  int aruco_id = 0;                 // from DICT_4X4_50
+  double marker_size = 2.0;         // m, the black square of the marker (or the panel's side)
+  Eigen::Vector3d panel_colour{1.0, 0.0, 1.0};  // cue: panel
+};
+
+struct LightSpec {
+  Eigen::Vector3d direction{-0.4, 0.3, -1.0};  // world frame, the way the light travels
+  double ambient = 0.45;
+  double diffuse = 0.65;
+};
+
+struct ImageEffectsSpec {
+  int msaa = 4;                   // samples per pixel (1 = off)
+  double noise_sigma = 0;         // grey levels (0-255) of Gaussian sensor noise
+  double blur_sigma = 0;          // px of Gaussian blur
+  double exposure_gain = 1;       // multiplies the image
+  double exposure_variation = 0;  // relative, per frame: gain * (1 + N(0, variation))
+  Eigen::Vector3d sky{0.62, 0.74, 0.88};  // colour where no surface is hit
+};
+
+struct WorldSpec {
+  TerrainSpec terrain{};
+  TextureSpec texture{};
+  ObjectsSpec objects{};
+  LeadModelSpec lead{};
+  LightSpec light{};
+  ImageEffectsSpec image{};
+  double near = 0.1, far = 1000;  // m, clip planes
+};
+
+// Terrain heights: seeded smooth relief around the mean height; with a ground lead, a flat road
+// under its path at the lead's true height minus its reference height (its wheels never float or
+// sink, DESIGN.md §3), and the land around it that road's height plus the relief.
+class TerrainModel {
+ public:
+  TerrainModel(const Scenario& scn, const OpenLoopTruth& truth);
+  double height(double x, double y) const;
+  Eigen::Vector3d normal(double x, double y) const;
+  // Square [xmin, ymin, xmax, ymax] the mesh covers.
+  const Eigen::Vector4d& bounds() const { return bounds_; }
+  // Horizontal distance to the lead's path.
+  double distance_to_path(double x, double y, double* path_ground = nullptr) const;
+
+ private:
+  double relief(double x, double y) const;
+  TerrainSpec spec_;
+  bool follow_ = false;
+  Eigen::Vector4d bounds_;
+  struct Wave { double kx, ky, phase, amp; };
+  std::vector<Wave> waves_;
+  std::vector<Eigen::Vector3d> path_;  // (x, y, ground height) samples of the lead's path
+};
+
+struct WorldObject {
+  enum class Type { Boulder, Tree, Building };
+  Type type = Type::Boulder;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // base centre on the ground
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();      // m: length, width, height
+  double yaw = 0;
+  Eigen::Vector3d colour{0.5, 0.5, 0.5};
+  std::uint32_t seed = 0;  // shape detail
+};
+
+// Objects over the terrain, reproducible from the scenario seed, clear of the lead's path.
+std::vector<WorldObject> scatter_objects(const Scenario& scn, const TerrainModel& terrain);
+
+// The roof cue floats this far above the model's top, so it never fights with the roof for depth.
+inline constexpr double kLeadCueLift = 0.01;
+// Height of the lead's reference point (the centre of its roof cue) above its ground contact:
+// the model's height plus kLeadCueLift.
+double lead_reference_height(const WorldSpec& w);
+
+}  // namespace wingman::sim

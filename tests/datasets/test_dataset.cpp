@@ -1,0 +1,187 @@
+// The dataset format: a written dataset reads back equal (images exactly, depth to the mm), and
+// the reader's errors name the file at fault (missing frame, wrong size, unknown version).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <sstream>
+
+#include "datasets/dataset.hpp"
+
+namespace wingman::datasets {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    static int n = 0;
+    path = fs::temp_directory_path() /
+           ("wingman-dataset-test-" + std::to_string(::getpid()) + "-" + std::to_string(n++));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+struct Written {
+  std::vector<cv::Mat> rgb, depth;
+};
+
+// Two agents: the lead (GPS) and one UAV with a 64 x 48 camera, three frames.
+Written write_small(const fs::path& dir, int channels = 3) {
+  DatasetInfo info;
+  info.scenario = "unit";
+  info.seed = 42;
+  info.software_version = "test";
+  info.rate = 10;
+  info.agents = {"lead", "uav1"};
+  DatasetWriter w(dir, info);
+  w.add_agent("lead", std::nullopt);
+  CameraInfo cam;
+  cam.camera = geometry::PinholeCamera(40, 41, 31.5, 23.5, 64, 48, {-0.1, 0.01, 0.001, 0, 0});
+  cam.R_CW << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+  cam.offset = {0.1, 0, -0.05};
+  cam.channels = channels;
+  w.add_agent("uav1", cam);
+  Written out;
+  cv::RNG rng(7);
+  for (int k = 0; k < 3; ++k) {
+    const auto t = step_ns(k, 10);
+    cv::Mat rgb(48, 64, CV_8UC3), depth(48, 64, CV_32F);
+    rng.fill(rgb, cv::RNG::UNIFORM, 0, 256);
+    rng.fill(depth, cv::RNG::UNIFORM, 5.0, 30.0);
+    depth.at<float>(0, 0) = 0;    // no surface
+    depth.at<float>(1, 1) = 80;   // beyond 65.535 m: unknown
+    w.write_frame("uav1", t, rgb, depth);
+    out.rgb.push_back(rgb);
+    out.depth.push_back(depth);
+    w.ground_truth("lead", {t, {1.0 * k, 2, 0}, {0, 0, 0.3826834, 0.9238795}, {1, 0, 0}});
+    w.ground_truth("uav1", {t, {1.0 * k, 2, 15}, {0, 0, 0, 1}, {1, 0, 0}});
+    w.camera_pose("uav1", {t, {1.0 * k + 0.1, 2, 14.95}, {1, 0, 0, 0}, {}});
+    w.gps("lead", {t, {1.0 * k + 0.5, 2.25, -0.125}});
+    w.altimeter("uav1", {t, 15.25});
+    w.range("uav1", {t, 15.5});
+    w.ahrs("uav1", {t, 0.0625});
+  }
+  w.finish();
+  return out;
+}
+
+TEST(Dataset, RoundTrip) {
+  TempDir tmp;
+  const Written w = write_small(tmp.path);
+  const Dataset ds = read_dataset(tmp.path);
+  EXPECT_EQ(ds.info.format_version, kFormatVersion);
+  EXPECT_EQ(ds.info.scenario, "unit");
+  EXPECT_EQ(ds.info.seed, 42u);
+  EXPECT_EQ(ds.info.frames, 3);
+  ASSERT_EQ(ds.agents.size(), 2u);
+  const AgentData& u = ds.agent("uav1");
+  ASSERT_TRUE(u.camera);
+  EXPECT_EQ(u.camera->camera.width(), 64);
+  EXPECT_DOUBLE_EQ(u.camera->camera.fy(), 41);
+  EXPECT_DOUBLE_EQ(u.camera->camera.cx(), 31.5);
+  EXPECT_DOUBLE_EQ(u.camera->camera.distortion().k1, -0.1);
+  EXPECT_DOUBLE_EQ(u.camera->R_CW(1, 1), -1);
+  EXPECT_DOUBLE_EQ(u.camera->offset.z(), -0.05);
+  ASSERT_EQ(u.frames.size(), 3u);
+  EXPECT_EQ(u.frames[2], 200000000);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(cv::norm(ds.load_image("uav1", u.frames[k]), w.rgb[k], cv::NORM_INF), 0);
+    const cv::Mat d = ds.load_depth("uav1", u.frames[k]);
+    EXPECT_EQ(d.at<float>(0, 0), 0);
+    EXPECT_EQ(d.at<float>(1, 1), 0);
+    cv::Mat diff = cv::abs(d - w.depth[k]);
+    diff.at<float>(1, 1) = 0;
+    double worst = 0;
+    cv::minMaxLoc(diff, nullptr, &worst);
+    EXPECT_LE(worst, 0.0005 + 1e-5);  // rounded to the millimetre (plus float rounding at 30 m)
+  }
+  EXPECT_DOUBLE_EQ(ds.agent("lead").groundtruth[2].p.x(), 2.0);
+  EXPECT_NEAR(ds.agent("lead").groundtruth[1].q_xyzw.z(), 0.3826834, 1e-9);
+  EXPECT_DOUBLE_EQ(ds.agent("lead").gps[1].value.y(), 2.25);
+  EXPECT_DOUBLE_EQ(u.altimeter[0].value, 15.25);
+  EXPECT_DOUBLE_EQ(u.range[0].value, 15.5);
+  EXPECT_DOUBLE_EQ(u.ahrs[0].value, 0.0625);
+  EXPECT_DOUBLE_EQ(u.camera_pose[0].q_xyzw.x(), 1);
+}
+
+TEST(Dataset, GrayFramesRoundTrip) {
+  TempDir tmp;
+  write_small(tmp.path, 1);
+  const Dataset ds = read_dataset(tmp.path);
+  EXPECT_EQ(ds.load_image("uav1", 0).channels(), 1);
+}
+
+std::string error_of(const fs::path& dir) {
+  try {
+    read_dataset(dir);
+  } catch (const DatasetError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(Dataset, MissingFrameNamesTheFile) {
+  TempDir tmp;
+  write_small(tmp.path);
+  const fs::path f = tmp.path / "uav1" / "cam0" / "data" / "100000000.png";
+  fs::remove(f);
+  const std::string e = error_of(tmp.path);
+  EXPECT_NE(e.find(f.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("missing frame"), std::string::npos) << e;
+}
+
+TEST(Dataset, WrongImageSizeNamesTheFile) {
+  TempDir tmp;
+  write_small(tmp.path);
+  const fs::path f = tmp.path / "uav1" / "depth0" / "data" / "0.png";
+  cv::imwrite(f.string(), cv::Mat(10, 12, CV_16U, cv::Scalar(1000)));
+  const std::string e = error_of(tmp.path);
+  EXPECT_NE(e.find(f.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("12x10"), std::string::npos) << e;
+}
+
+TEST(Dataset, UnknownFormatVersionNamesTheFile) {
+  TempDir tmp;
+  write_small(tmp.path);
+  const fs::path y = tmp.path / "dataset.yaml";
+  std::ifstream in(y);
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  text.replace(text.find("format_version: 1"), 17, "format_version: 7");
+  std::ofstream(y) << text;
+  const std::string e = error_of(tmp.path);
+  EXPECT_NE(e.find(y.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown format_version 7"), std::string::npos) << e;
+}
+
+TEST(Dataset, UnfinishedDirectoryIsNotADataset) {
+  TempDir tmp;
+  write_small(tmp.path);
+  fs::remove(tmp.path / "dataset.yaml");
+  EXPECT_NE(error_of(tmp.path).find("dataset.yaml: missing"), std::string::npos);
+  EXPECT_NE(error_of(tmp.path / "nope").find("not a directory"), std::string::npos);
+}
+
+TEST(Dataset, CorruptCsvRowNamesTheFileAndLine) {
+  TempDir tmp;
+  write_small(tmp.path);
+  const fs::path csv = tmp.path / "uav1" / "altimeter0" / "data.csv";
+  std::ofstream(csv, std::ios::app) << "300000000,abc\n";
+  const std::string e = error_of(tmp.path);
+  EXPECT_NE(e.find(csv.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("'abc' is not a number"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace wingman::datasets

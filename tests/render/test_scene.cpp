@@ -1,0 +1,160 @@
+// The world built from a scenario: the paper's scene renders the same twice, the lead's
+// reference point is the centre of its roof marker and it spans >= 30 px from 15 m, and bad
+// asset paths are clear errors naming the file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "render/renderer.hpp"
+#include "render/scene.hpp"
+#include "render_test_support.hpp"
+#include "sim/truth.hpp"
+
+namespace wingman::render {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::backend_name;
+
+const std::string kPaper = std::string(WINGMAN_SOURCE_DIR) + "/scenes/paper_synthetic.yaml";
+
+sim::Scenario paper(int size = 200) {
+  sim::Scenario s = sim::load_scenarios(kPaper).front();
+  s.world.texture.anisotropy = 4;
+  for (auto& u : s.uavs) {
+    // Same field of view as the paper's camera, fewer pixels: fast on llvmpipe.
+    const double k = size / 1000.0;
+    u.camera.fx = u.camera.fy = 200.1 * k;
+    u.camera.cx = u.camera.cy = 500 * k + 0.5 * k - 0.5;
+    u.camera.width = u.camera.height = size;
+  }
+  return s;
+}
+
+struct TempDir {
+  fs::path path = fs::temp_directory_path() / ("wingman-scene-test-" + std::to_string(::getpid()));
+  TempDir() { fs::create_directories(path); }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+TEST(Scene, LeadIsScaledToItsHeightAndSpansThirtyPixelsFromFifteenMetres) {
+  const sim::Scenario scn = sim::load_scenarios(kPaper).front();
+  const Scene s = build_scene(scn);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+  for (const auto& m : s.lead_meshes)
+    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+      const Eigen::Vector3d p(m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]);
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  EXPECT_NEAR(hi.z(), 0.0, 1e-6);  // the reference point is on top: the roof cue
+  EXPECT_NEAR(hi.z() - lo.z(), scn.world.lead.height + sim::kLeadCueLift, 1e-3);
+  const double span_px = 200.1 * (hi.x() - lo.x()) / 15.0;
+  EXPECT_GE(span_px, 30.0);
+}
+
+TEST(Scene, MissingModelNonModelAndMissingTextureAreErrorsNamingTheFile) {
+  TempDir tmp;
+  sim::LeadModelSpec spec;
+  Scene s;
+  const std::string missing = (tmp.path / "no_such_truck.glb").string();
+  try {
+    load_lead_model(spec, missing, s);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos) << e.what();
+  }
+  const std::string junk = (tmp.path / "junk.glb").string();
+  std::ofstream(junk) << "this is not a 3D model\n";
+  try {
+    load_lead_model(spec, junk, s);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(junk), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not a 3D model"), std::string::npos) << e.what();
+  }
+  sim::Scenario scn = paper();
+  scn.world.texture.image = "no_such_aerial.jpg";
+  try {
+    build_scene(scn);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_aerial.jpg"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("scenes/no_such_aerial.jpg"), std::string::npos)
+        << "should say where it looked: " << e.what();
+  }
+}
+
+TEST(Scene, RelativeAssetsResolveNextToTheScenarioFirst) {
+  TempDir tmp;
+  std::ofstream(tmp.path / "tex.png") << "x";
+  const std::string scn_file = (tmp.path / "s.yaml").string();
+  EXPECT_EQ(resolve_asset("tex.png", scn_file, "texture"), (tmp.path / "tex.png").string());
+  EXPECT_NE(resolve_asset("aerial/freetown_drone_nadir.jpg", scn_file, "texture").find("assets"),
+            std::string::npos);
+}
+
+TEST(Scene, ProceduralTextureIsSeeded) {
+  sim::Scenario a = paper();
+  a.world.texture.type = sim::TextureSpec::Type::Procedural;
+  a.world.texture.size = 256;
+  sim::Scenario b = a;
+  b.seed = a.seed + 1;
+  const Scene sa = build_scene(a), sa2 = build_scene(a), sb = build_scene(b);
+  EXPECT_EQ(cv::norm(sa.materials[0].texture, sa2.materials[0].texture, cv::NORM_INF), 0);
+  EXPECT_GT(cv::norm(sa.materials[0].texture, sb.materials[0].texture, cv::NORM_INF), 0);
+}
+
+class PaperSceneTest : public ::testing::TestWithParam<GlBackend> {};
+
+TEST_P(PaperSceneTest, SameScenarioAndSeedGiveIdenticalImages) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  const sim::Scenario scn = paper();
+  const sim::OpenLoopTruth truth(scn);
+  const double t = 12.3;
+  const CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(t), truth.camera(0, t).position};
+  Frame first, second;
+  {
+    Renderer r(ctx, build_scene(scn));
+    first = r.render(view, lead_pose(scn, t));
+  }
+  {
+    Renderer r(ctx, build_scene(scn));
+    second = r.render(view, lead_pose(scn, t));
+  }
+  EXPECT_EQ(cv::norm(first.rgb, second.rgb, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(first.depth, second.depth, cv::NORM_INF), 0);
+}
+
+TEST_P(PaperSceneTest, LeadReferencePointIsWhereTheDepthSaysAndBothUavsSeeIt) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  const sim::Scenario scn = paper(400);
+  const sim::OpenLoopTruth truth(scn);
+  Renderer r(ctx, build_scene(scn));
+  for (double t : {0.0, 30.0}) {
+    const LeadPose lead = lead_pose(scn, t);
+    for (int j = 0; j < 2; ++j) {
+      const CameraView view{scn.uavs[j].camera.camera(), truth.camera_R_CW(t),
+                            truth.camera(j, t).position};
+      const Frame f = r.render(view, lead);
+      const Eigen::Vector3d p_C = view.R_CW * (lead.position - view.x_c);
+      const auto uv = view.camera.project(p_C);
+      ASSERT_TRUE(uv && view.camera.in_image(*uv, 20)) << "lead out of view of uav" << j + 1;
+      const float d = f.depth.at<float>(static_cast<int>(std::lround(uv->y())),
+                                        static_cast<int>(std::lround(uv->x())));
+      EXPECT_NEAR(d, p_C.z(), 0.02) << "uav" << j + 1 << " t=" << t;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, PaperSceneTest,
+                         ::testing::Values(GlBackend::Egl, GlBackend::OsMesa), backend_name);
+
+}  // namespace
+}  // namespace wingman::render
