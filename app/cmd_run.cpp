@@ -16,6 +16,7 @@
 #include "eval/plots.hpp"
 #include "eval/results_dir.hpp"
 #include "eval/writers.hpp"
+#include "render/gl_context.hpp"
 #include "sim/scenario.hpp"
 
 namespace fs = std::filesystem;
@@ -29,11 +30,18 @@ struct RunOptions {
   std::string out;
   std::optional<std::uint64_t> seed;
   std::vector<std::string> variants;
+  std::string gl = "auto";
   bool no_plots = false;
   bool quiet = false;
 };
 
 int run_command(const RunOptions& o) {
+  render::GlBackend gl;
+  try {
+    gl = render::gl_backend_from_string(o.gl);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
   auto scenarios = sim::load_scenarios(o.scenario);
   if (!o.variants.empty()) {
     std::vector<sim::Scenario> keep;
@@ -70,7 +78,12 @@ int run_command(const RunOptions& o) {
   for (const auto& scn : scenarios) {
     const std::string label = scn.variant.empty() ? scn.name : scn.name + "/" + scn.variant;
     ProgressLine progress(fmt::format("[{}]", label), o.quiet);
-    const eval::RunRecord rec = run_synthetic(scn, [&](int k, int n) { progress.update(k, n, "steps"); });
+    eval::RunRecord rec;
+    try {
+      rec = run_scenario(scn, gl, [&](int k, int n) { progress.update(k, n, "steps"); });
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());  // a world or frontend setting the scenario got wrong
+    }
     progress.finish();
 
     const fs::path dir = nested ? results.staging() / scn.variant : results.staging();
@@ -110,6 +123,9 @@ Subcommand add_run(CLI::App& parent) {
   cmd->add_option("--out,-o", o->out, "Results directory (default: results/<scenario name>)");
   cmd->add_option("--seed", o->seed, "Override the scenario's seed");
   cmd->add_option("--variant", o->variants, "Run only these variants (repeatable)");
+  cmd->add_option("--gl", o->gl,
+                  "OpenGL backend for rendered scenarios: auto (EGL, then OSMesa), egl or osmesa")
+      ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
   cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return run_command(*o); }};

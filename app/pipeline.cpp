@@ -5,8 +5,10 @@
 #include <chrono>
 #include <functional>
 #include <map>
+#include <memory>
 #include <stdexcept>
 
+#include "app/rendered_frontend.hpp"
 #include "app/version.hpp"
 #include "control/formation.hpp"
 #include "control/sliding_mode.hpp"
@@ -69,9 +71,12 @@ struct LoopHooks {
   std::function<void(int k, double t, const slam::Estimator&, eval::StepRecord&)> control;
 };
 
+// Synthetic mode: every measurement from `source`. Rendered mode: the visual ones from rendered
+// frames through the vision frontend, the others (GPS, altimeter, range) still from `source`.
 eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
                          sim::SyntheticSource& source, const ProgressFn& progress,
-                         const StateObserver& observer, const LoopHooks& hooks) {
+                         const StateObserver& observer, const LoopHooks& hooks,
+                         render::GlBackend gl) {
   const auto wall0 = Clock::now();
   const bool single = scn.estimator.mode == sim::EstimatorMode::SingleUav;
 
@@ -83,6 +88,9 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     for (int j = 0; j < static_cast<int>(scn.uavs.size()); ++j) cam_uav.push_back(j);
   }
   const int ncam = static_cast<int>(cam_uav.size());
+  std::unique_ptr<RenderedFrontend> fe;
+  if (scn.measurements == sim::MeasurementMode::Rendered)
+    fe = std::make_unique<RenderedFrontend>(scn, cam_uav, gl);
 
   std::vector<slam::CameraRig> rigs;
   std::vector<slam::AgentInit> cam_init;
@@ -113,12 +121,18 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   for (int u : cam_uav) rec.outliers.push_back({scn.uavs[u].name});
   if (!single) rec.outliers.push_back({"cooperative"});
   eval::OutlierCounts* coop = single ? nullptr : &rec.outliers.back();
+  if (fe) {
+    rec.frontend.enabled = true;
+    rec.frontend.detector = fe->detector_name();
+    rec.frontend.renderer = fe->renderer_description();
+  }
 
   std::map<slam::LandmarkId, std::size_t> lm_record;  // filter id -> index in rec.landmarks
   const int target = scn.estimator.target_landmarks_per_camera;
 
   auto record_step = [&](int k, double t, int visible, int offered, int accepted, int initialised,
-                         double tp, double tu, double ti) {
+                         double tp, double tu, double ti, double tr = 0, double td = 0,
+                         double tm = 0) {
     eval::StepRecord st;
     st.k = k;
     st.t = t;
@@ -148,6 +162,9 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     st.t_predict_ms = tp;
     st.t_update_ms = tu;
     st.t_init_ms = ti;
+    st.t_render_ms = tr;
+    st.t_detect_ms = td;
+    st.t_match_ms = tm;
     rec.steps.push_back(std::move(st));
   };
   // Latest estimate of every landmark in the map; a landmark removed later keeps its last one.
@@ -173,12 +190,20 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     auto t0 = Clock::now();
     est.predict(dt);
     const double t_predict = ms_since(t0);
+    double t_render = 0, t_detect = 0, t_match = 0;
+    if (fe) {
+      t_render = fe->render(truth, t);
+      for (int j = 0; j < ncam; ++j) est.set_camera_rotation(j, truth.commanded_R_CW());
+      t_detect = fe->detect(est, rec.frontend);
+    }
 
     // Landmark correspondences for what the filter predicts in view, by identity.
     t0 = Clock::now();
     std::vector<slam::Correspondence> cands;
     std::vector<sim::PixelObservation> obs_all;
     std::vector<int> cand_channel;
+    std::vector<LabelledCorrespondence> labelled;  // rendered mode, parallel to cands
+    double t_track = 0;
     std::vector<int> in_view(ncam, 0);
     std::vector<bool> sees_landmarks(ncam, false);
     int visible = 0;
@@ -190,6 +215,16 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
       const auto preds = est.landmarks_in_view(j);
       in_view[j] = static_cast<int>(preds.size());
       visible += in_view[j];
+      if (fe) {
+        const auto tm0 = Clock::now();
+        for (const auto& lc : fe->track(j, preds)) {
+          cands.push_back(lc.c);
+          labelled.push_back(lc);
+          cand_channel.push_back(j);
+        }
+        t_track += ms_since(tm0);
+        continue;
+      }
       std::vector<std::int64_t> ids;
       for (const auto& p : preds) ids.push_back(p.id);
       for (const auto& o : source.observe_landmarks(cam_uav[j], t, ids)) {
@@ -201,18 +236,23 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     std::vector<std::pair<int, Eigen::Vector2d>> lead_pixels;
     for (int j = 0; j < ncam; ++j)
       if (scn.sensor_active(sim::Sensor::LeadProjection, t, scn.uavs[cam_uav[j]].name))
-        if (auto uv = source.lead_pixel(cam_uav[j], t)) lead_pixels.emplace_back(j, *uv);
+        if (auto uv = fe ? fe->lead_pixel(j) : source.lead_pixel(cam_uav[j], t))
+          lead_pixels.emplace_back(j, *uv);
     const auto vr = est.update_visual(cands, lead_pixels);
     int accepted = 0;
     for (size_t i = 0; i < cands.size(); ++i) {
       auto& oc = rec.outliers[cand_channel[i]];
       ++oc.correspondences;
-      // Synthetic mode: an outlier is a correspondence the source corrupted (DESIGN.md §3).
-      if (obs_all[i].injected_outlier) ++oc.injected, ++oc.outliers;
+      // Synthetic mode: an outlier is a correspondence the source corrupted (DESIGN.md §3);
+      // rendered mode: one the ground-truth labels put > 3 px from the true projection (§7).
+      const bool outlier = fe ? labelled[i].outlier : obs_all[i].injected_outlier;
+      if (!fe && outlier) ++oc.injected;
+      if (outlier) ++oc.outliers;
       if (vr.accepted[i]) {
         ++accepted;
         ++oc.accepted;
-        if (obs_all[i].injected_outlier) ++oc.outliers_accepted;
+        if (outlier) ++oc.outliers_accepted;
+        if (fe) fe->accepted(labelled[i], k);
       }
     }
 
@@ -226,12 +266,30 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
       if (scn.sensor_active(sim::Sensor::Range, t, name)) batch.range.emplace_back(j, source.range(u, t));
     }
     est.update_sensors(batch);
-    const double t_update = ms_since(t0);
+    const double t_update = ms_since(t0) - t_track;
+    t_match += t_track;
     snapshot_landmarks(phase);
 
     // New landmarks where a camera sees fewer than the target.
     t0 = Clock::now();
     int initialised = 0;
+    double t_cross = 0;
+    // Rendered mode: the landmark's truth is the back-projection of its first observation.
+    auto add_rendered = [&](slam::LandmarkId id, int cam, int keypoint, const Eigen::Vector2d& uv,
+                            const char* origin) {
+      ++initialised;
+      const auto truth_point = fe->added(id, cam, keypoint, uv, k);
+      if (!truth_point) return;  // no rendered surface there: left out of Table 5
+      eval::LandmarkRecord lr;
+      lr.id = id;
+      lr.truth = *truth_point;
+      lr.t_init = t;
+      lr.init_phase = phase;
+      lr.est_init = lr.est_phase_end = lr.est_final = *est.landmark_position(id);
+      lr.origin = origin;
+      lm_record[id] = rec.landmarks.size();
+      rec.landmarks.push_back(lr);
+    };
     auto add_record = [&](slam::LandmarkId id, std::size_t point, const char* origin) {
       source.bind(id, point);
       eval::LandmarkRecord lr;
@@ -247,7 +305,15 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     };
     if (single) {
       const int need = target - in_view[0];
-      if (sees_landmarks[0] && need > 0)
+      if (fe && sees_landmarks[0] && need > 0) {
+        const auto tm0 = Clock::now();
+        const auto pts = fe->new_points(0, need);
+        t_cross += ms_since(tm0);
+        for (const auto& p : pts) {
+          auto r = est.initialise_from_pixel(0, p.c.uv);
+          if (r.id) add_rendered(*r.id, 0, p.keypoint, p.c.uv, "inverse_depth");
+        }
+      } else if (sees_landmarks[0] && need > 0)
         for (const auto& o : source.new_points(cam_uav[0], t, need)) {
           auto r = est.initialise_from_pixel(0, o.uv);
           if (r.id) add_record(*r.id, o.point, "inverse_depth");
@@ -263,6 +329,24 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
         pairs[key] = std::max(pairs[key], need);
       }
       for (const auto& [pr, need] : pairs) {
+        if (fe) {
+          const auto tm0 = Clock::now();
+          const auto pairs_found = fe->cross_match(pr.first, pr.second, need, est);
+          t_cross += ms_since(tm0);
+          std::vector<slam::CrossMatch> cm;
+          for (const auto& p : pairs_found) cm.push_back(p.m);
+          const auto outcomes = est.initialise_from_matches(cm);
+          for (size_t i = 0; i < pairs_found.size(); ++i) {
+            ++coop->correspondences;
+            if (pairs_found[i].outlier) ++coop->outliers;
+            if (!outcomes[i].id) continue;
+            ++coop->accepted;
+            if (pairs_found[i].outlier) ++coop->outliers_accepted;
+            add_rendered(*outcomes[i].id, pr.first, pairs_found[i].keypoint_a, pairs_found[i].m.uv_a,
+                         "cooperative");
+          }
+          continue;
+        }
         const auto matches = source.cross_matches(cam_uav[pr.first], cam_uav[pr.second], t, need);
         std::vector<slam::CrossMatch> cm;
         for (const auto& m : matches) cm.push_back({pr.first, pr.second, m.uv_a, m.uv_b});
@@ -279,12 +363,14 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     }
     for (slam::LandmarkId id : est.end_step()) {
       source.unbind(id);
+      if (fe) fe->removed(id);
       if (auto it = lm_record.find(id); it != lm_record.end()) rec.landmarks[it->second].t_removed = t;
     }
-    const double t_init = ms_since(t0);
+    const double t_init = ms_since(t0) - t_cross;
+    t_match += t_cross;
 
     record_step(k, t, visible, static_cast<int>(cands.size()), accepted, initialised, t_predict,
-                t_update, t_init);
+                t_update, t_init, t_render, t_detect, t_match);
     if (hooks.control) hooks.control(k, t, est, rec.steps.back());
     if (observer) observer(k, est.state());
     if (progress) progress(k, N);
@@ -315,7 +401,7 @@ control::SlidingModeSettings controller_settings(const sim::ControlSpec& c) {
 // Section 7.3: the estimator's positions and the AHRS yaw feed one sliding-mode controller per
 // UAV; its command, plus Delta_g (eq. 58), drives eq. 53 until the next step (ZOH, Fig. 7).
 eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& progress,
-                                const StateObserver& observer) {
+                                const StateObserver& observer, render::GlBackend gl) {
   if (scn.estimator.mode != sim::EstimatorMode::MultiUav)
     throw std::invalid_argument("closed loop needs the multi-UAV estimator");
   sim::ClosedLoopTruth truth(scn);
@@ -386,7 +472,7 @@ eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& prog
     }
   };
 
-  eval::RunRecord rec = run_loop(scn, truth, source, progress, observer, hooks);
+  eval::RunRecord rec = run_loop(scn, truth, source, progress, observer, hooks, gl);
   rec.closed_loop = true;
   for (const auto& u : scn.uavs) rec.formation_uavs.push_back(u.name);
   rec.settling_time = scn.control.settling_time;
@@ -394,18 +480,23 @@ eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& prog
 }
 
 eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progress,
-                              const StateObserver& observer) {
+                              const StateObserver& observer, render::GlBackend gl) {
   const sim::OpenLoopTruth truth(scn);
   sim::SyntheticSource source(scn, truth);
-  return run_loop(scn, truth, source, progress, observer, {});
+  return run_loop(scn, truth, source, progress, observer, {}, gl);
 }
 
 }  // namespace
 
+eval::RunRecord run_scenario(const sim::Scenario& scn, render::GlBackend gl,
+                             const ProgressFn& progress, const StateObserver& observer) {
+  return scn.closed_loop() ? run_closed_loop(scn, progress, observer, gl)
+                           : run_open_loop(scn, progress, observer, gl);
+}
+
 eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress,
                               const StateObserver& observer) {
-  return scn.closed_loop() ? run_closed_loop(scn, progress, observer)
-                           : run_open_loop(scn, progress, observer);
+  return run_scenario(scn, render::GlBackend::Auto, progress, observer);
 }
 
 }  // namespace wingman::app

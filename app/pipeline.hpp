@@ -1,4 +1,4 @@
-// The pipeline on synthetic measurements: truth -> synthetic source -> estimator, and in closed
+// The pipeline: truth -> synthetic source or rendered frames + vision frontend -> estimator, and in closed
 // loop -> controller -> truth, one step at a time, with the bookkeeping evaluation needs (truth
 // of every landmark the filter initialises, outliers injected and accepted, per-stage timings).
 // Only app/ wires sim, slam and control.
@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "eval/run_record.hpp"
+#include "render/gl_context.hpp"
 #include "sim/scenario.hpp"
 #include "slam/state.hpp"
 
@@ -20,6 +21,11 @@ using StateObserver = std::function<void(int, const slam::FilterState&)>;
 
 // Open loop (truth known in advance), or closed loop when the scenario has a control: section:
 // then the UAVs fly the sliding-mode controller's commands computed from the estimates (section 6).
+// The scenario's `measurements:` mode decides where the visual measurements come from:
+// synthetic projections, or frames rendered with an OpenGL context of backend `gl` (rendered).
+eval::RunRecord run_scenario(const sim::Scenario& scn, render::GlBackend gl = render::GlBackend::Auto,
+                             const ProgressFn& progress = {}, const StateObserver& observer = {});
+// run_scenario with the automatic GL backend (a synthetic scenario never makes a context).
 eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress = {},
                               const StateObserver& observer = {});
 

@@ -93,7 +93,7 @@ Metrics compute_metrics(const RunRecord& run) {
   std::vector<ErrorAccumulator> total_err(n_agents);
   std::vector<MeanAccumulator> phase_nees(n_phases);
   MeanAccumulator run_nees;
-  std::vector<double> t_predict, t_update, t_init, t_total;
+  std::vector<double> t_predict, t_update, t_init, t_total, t_render, t_detect, t_match;
 
   Metrics m;
   m.nees.per_step.reserve(run.steps.size());
@@ -121,7 +121,11 @@ Metrics compute_metrics(const RunRecord& run) {
     t_predict.push_back(s.t_predict_ms);
     t_update.push_back(s.t_update_ms);
     t_init.push_back(s.t_init_ms);
-    t_total.push_back(s.t_predict_ms + s.t_update_ms + s.t_init_ms);
+    t_total.push_back(s.t_predict_ms + s.t_update_ms + s.t_init_ms + s.t_render_ms + s.t_detect_ms +
+                      s.t_match_ms);
+    t_render.push_back(s.t_render_ms);
+    t_detect.push_back(s.t_detect_ms);
+    t_match.push_back(s.t_match_ms);
 
     if (s.phase < 0) continue;
     phase_nees[s.phase].add(s.nees);
@@ -166,6 +170,20 @@ Metrics compute_metrics(const RunRecord& run) {
   m.timings_ms.update = summarise(std::move(t_update));
   m.timings_ms.init = summarise(std::move(t_init));
   m.timings_ms.total = summarise(std::move(t_total));
+  m.timings_ms.render = summarise(std::move(t_render));
+  m.timings_ms.detect = summarise(std::move(t_detect));
+  m.timings_ms.match = summarise(std::move(t_match));
+  if (run.frontend.enabled) {
+    const FrontendRecord& f = run.frontend;
+    m.frontend.present = true;
+    m.frontend.frames = f.frames;
+    m.frontend.lead_in_view = f.lead_in_view;
+    m.frontend.lead_detected = f.lead_detected;
+    m.frontend.lead_false = f.lead_false;
+    if (f.lead_in_view > 0)
+      m.frontend.lead_detection_rate = static_cast<double>(f.lead_detected) / f.lead_in_view;
+    m.frontend.lead_error_px = summarise(f.lead_error_px);
+  }
   m.landmarks.initialised = static_cast<long>(run.landmarks.size());
   m.formation = compute_formation_metrics(run);
   return m;

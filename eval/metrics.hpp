@@ -60,7 +60,15 @@ struct Stats {
 };
 
 struct Timings {
-  Stats predict, update, init, total;  // ms per step; total = predict + update + init
+  Stats predict, update, init, total;  // ms per step; total = every stage below summed
+  Stats render, detect, match;         // rendered mode only (0 in synthetic mode)
+};
+// Rendered mode: the lead detector against the truth.
+struct FrontendMetrics {
+  bool present = false;
+  double lead_detection_rate = kNaN;  // lead_detected / lead_in_view
+  Stats lead_error_px;
+  long lead_in_view = 0, lead_detected = 0, lead_false = 0, frames = 0;
 };
 
 struct LandmarkCounts {
@@ -77,6 +85,7 @@ struct Metrics {
   Timings timings_ms;
   LandmarkCounts landmarks;
   FormationMetrics formation;  // closed loop only (formation.hpp)
+  FrontendMetrics frontend;    // rendered mode only
 };
 
 // Throws std::invalid_argument if a step's agent count differs from agent_names or a step

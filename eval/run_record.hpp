@@ -49,6 +49,8 @@ struct StepRecord {
   int matches_accepted = 0;
   int initialised = 0;            // landmarks added this step
   double t_predict_ms = 0, t_update_ms = 0, t_init_ms = 0;
+  // Rendered mode: rendering, lead detection + features, tracking + cross matching (0 otherwise).
+  double t_render_ms = 0, t_detect_ms = 0, t_match_ms = 0;
   std::vector<FormationStep> formation;  // closed loop: per RunRecord::formation_uavs; else empty
 };
 
@@ -77,6 +79,19 @@ struct OutlierCounts {
   long outliers_accepted = 0;   // outliers among those
 };
 
+// Rendered mode only: what the lead detector did against the truth, over every camera frame.
+struct FrontendRecord {
+  bool enabled = false;
+  std::string detector;   // feature detector, e.g. "orb"
+  std::string renderer;   // GL context description
+  long frames = 0;        // camera frames processed
+  long lead_in_view = 0;  // frames whose true lead reference point projects inside the image
+  long lead_detected = 0; // of those, frames with a detection within lead_match_px of the truth
+  long lead_false = 0;    // detections farther than lead_match_px, or with the lead out of view
+  double lead_match_px = 10;
+  std::vector<double> lead_error_px;  // detection to true projection, for the lead_detected frames
+};
+
 struct PhaseInfo {
   std::string name;
   double t_start = 0, t_end = 0;
@@ -93,6 +108,7 @@ struct RunRecord {
   std::vector<StepRecord> steps;
   std::vector<LandmarkRecord> landmarks;
   std::vector<OutlierCounts> outliers;
+  FrontendRecord frontend;
   double wall_time_s = 0;
   // Closed loop (section 6): the controlled UAVs and when formation metrics start in a phase.
   bool closed_loop = false;

@@ -125,6 +125,22 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
                      {"update", stats(m.timings_ms.update)},
                      {"init", stats(m.timings_ms.init)},
                      {"total", stats(m.timings_ms.total)}};
+  if (m.frontend.present) {
+    // Rendered mode only, so that synthetic metrics.json stays as it was.
+    j["timings_ms"]["render"] = stats(m.timings_ms.render);
+    j["timings_ms"]["detect"] = stats(m.timings_ms.detect);
+    j["timings_ms"]["match"] = stats(m.timings_ms.match);
+    const FrontendMetrics& f = m.frontend;
+    j["frontend"] = {{"detector", run.frontend.detector},
+                     {"renderer", run.frontend.renderer},
+                     {"frames", f.frames},
+                     {"lead_in_view", f.lead_in_view},
+                     {"lead_detected", f.lead_detected},
+                     {"lead_false_detections", f.lead_false},
+                     {"lead_match_px", num(run.frontend.lead_match_px)},
+                     {"lead_detection_rate", num(f.lead_detection_rate)},
+                     {"lead_error_px", stats(f.lead_error_px)}};
+  }
   j["landmarks"] = {{"initialised", m.landmarks.initialised},
                     {"max_in_state", m.landmarks.max_in_state},
                     {"count_per_step", m.landmarks.count_per_step}};
@@ -364,6 +380,16 @@ std::string format_summary(const Metrics& m, const RunRecord& run) {
                  cell(t.total.mean, 0, 3), cell(t.predict.mean, 0, 3), cell(t.update.mean, 0, 3),
                  cell(t.init.mean, 0, 3), cell(t.total.median, 0, 3), cell(t.total.p95, 0, 3),
                  cell(t.total.max, 0, 3));
+  if (m.frontend.present) {
+    fmt::format_to(out, "Stages [ms/step, mean]: render {}, detect {}, match {}, EKF {}, init {}\n",
+                   cell(t.render.mean, 0, 3), cell(t.detect.mean, 0, 3), cell(t.match.mean, 0, 3),
+                   cell(t.predict.mean + t.update.mean, 0, 3), cell(t.init.mean, 0, 3));
+    const FrontendMetrics& f = m.frontend;
+    fmt::format_to(out, "Lead detector: {} of {} frames in view ({}), error median {} px, p95 {} px, "
+                   "{} false\n",
+                   f.lead_detected, f.lead_in_view, cell(f.lead_detection_rate, 0, 3),
+                   cell(f.lead_error_px.median, 0, 3), cell(f.lead_error_px.p95, 0, 3), f.lead_false);
+  }
   fmt::format_to(out, "Landmarks: {} initialised, at most {} in the state\n",
                  m.landmarks.initialised, m.landmarks.max_in_state);
   fmt::format_to(out, "{}", format_formation_summary(m.formation, run));

@@ -95,6 +95,8 @@ const char* to_string(MeasurementMode m) {
   switch (m) {
     case MeasurementMode::Synthetic:
       return "synthetic";
+    case MeasurementMode::Rendered:
+      return "rendered";
   }
   return "unknown";
 }

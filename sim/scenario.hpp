@@ -29,7 +29,9 @@ std::vector<Sensor> sensors_of(Config c);
 enum class EstimatorMode { MultiUav, SingleUav };
 const char* to_string(EstimatorMode m);
 
-enum class MeasurementMode { Synthetic };
+// Synthetic: projections of a point field with the paper's noise; Rendered: rendered frames
+// through the vision frontend (app/).
+enum class MeasurementMode { Synthetic, Rendered };
 const char* to_string(MeasurementMode m);
 
 // Lead trajectory of eq. 66, shifted so that it starts at `initial_position`.

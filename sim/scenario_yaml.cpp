@@ -957,10 +957,13 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   num(ctx, top, "rate", base.rate, in(0, 1000, true, false));
   if (auto f = top.get("measurements")) {
     const std::string& s = scalar_of(ctx, *f, "a measurement mode");
-    if (s != "synthetic")
-      ctx.fail(f->loc(),
-               fmt::format("unknown measurement mode '{}' (the only one is 'synthetic')", s));
-    base.measurements = MeasurementMode::Synthetic;
+    if (s == "synthetic")
+      base.measurements = MeasurementMode::Synthetic;
+    else if (s == "rendered")
+      base.measurements = MeasurementMode::Rendered;
+    else
+      ctx.fail(f->loc(), fmt::format(
+                             "unknown measurement mode '{}' (expected 'synthetic' or 'rendered')", s));
   }
   if (auto f = top.get("lead")) parse_lead(ctx, *f, base.lead);
   if (auto f = top.get("uavs")) parse_uavs(ctx, *f, base.uavs, prov);

@@ -303,8 +303,8 @@ uavs:
               HasSubstr("phases[0].add[0]: unknown sensor 'gsp' (did you mean 'gps'?)"));
   EXPECT_THAT(error_of("estimator: {mode: solo}\n"),
               HasSubstr("estimator.mode: expected multi or single, got 'solo'"));
-  EXPECT_THAT(error_of("measurements: rendered\n"),
-              HasSubstr("scn.yaml:1:15: measurements: unknown measurement mode 'rendered'"));
+  EXPECT_THAT(error_of("measurements: photos\n"),
+              HasSubstr("scn.yaml:1:15: measurements: unknown measurement mode 'photos'"));
   EXPECT_THAT(error_of("lead: {trajectory: {type: circle}}\n"),
               HasSubstr("lead.trajectory.type: unknown trajectory type 'circle'"));
 }

@@ -1,0 +1,243 @@
+#include "app/rendered_frontend.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "render/effects.hpp"
+#include "render/scene.hpp"
+
+namespace wingman::app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+vision::LeadDetectorSettings lead_settings(const sim::Scenario& scn) {
+  vision::LeadDetectorSettings s;
+  switch (scn.world.lead.cue) {
+    case sim::LeadModelSpec::Cue::Aruco:
+      s.method = vision::LeadMethod::Marker;
+      s.marker_id = scn.world.lead.aruco_id;
+      break;
+    case sim::LeadModelSpec::Cue::Panel:
+      s.method = vision::LeadMethod::Colour;
+      break;
+    case sim::LeadModelSpec::Cue::None:
+      throw std::invalid_argument(scn.source_path +
+                                  ": world.lead.cue: none leaves the lead detector nothing to find "
+                                  "(rendered measurements need aruco or panel)");
+  }
+  return s;
+}
+
+// Box kept free of map features around the lead: its detection, or else its predicted pixel,
+// sized for the model's footprint at the camera's height (the model moves: features on it would
+// make landmarks that drift).
+vision::ExclusionBox predicted_lead_box(const Eigen::Vector2d& uv, double fx, double depth,
+                                        const sim::Scenario& scn) {
+  const double half = std::max(20.0, 0.5 * 2.0 * scn.world.lead.height * fx / std::max(depth, 1.0));
+  return {uv, half, half};
+}
+
+}  // namespace
+
+RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav,
+                                   render::GlBackend backend)
+    : scn_(scn), cam_uav_(std::move(cam_uav)), lead_(lead_settings(scn)) {
+  render::Scene scene;
+  try {
+    scene = render::build_scene(scn);
+  } catch (const std::runtime_error& e) {  // a missing or broken asset: the scenario's fault
+    throw std::invalid_argument(scn.source_path + ": world: " + e.what());
+  }
+  ctx_ = render::create_gl_context(backend);
+  renderer_ = std::make_unique<render::Renderer>(*ctx_, scene);
+  colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
+  // The estimator rejects pairs under its minimum parallax; filtering them before the spread
+  // selection lets it pick among pairs that can be initialised (with a 3 m baseline, most of
+  // the image's outer cells are under 8 degrees and would be chosen, and rejected, every step).
+  cross_.min_parallax_deg = scn.estimator.min_parallax_deg;
+  for (int u : cam_uav_) {
+    Cam c;
+    c.model = scn.uavs[u].camera.camera();
+    cams_.push_back(std::move(c));
+    effects_.push_back(
+        std::make_unique<render::ImageEffects>(scn.world.image, scn.seed, scn.uavs[u].name));
+  }
+}
+
+RenderedFrontend::~RenderedFrontend() = default;
+
+std::string RenderedFrontend::renderer_description() const { return ctx_->description(); }
+
+double RenderedFrontend::render(const sim::Truth& truth, double t) {
+  const auto t0 = Clock::now();
+  render::LeadPose lead = render::lead_pose(scn_, t);
+  lead.position = truth.lead(t).position;
+  const Eigen::Matrix3d R_CW = truth.camera_R_CW(t);
+  for (std::size_t j = 0; j < cams_.size(); ++j) {
+    Cam& c = cams_[j];
+    c.true_pose = {R_CW, truth.camera(cam_uav_[j], t).position};
+    c.frame = renderer_->render({c.model, R_CW, c.true_pose.position}, lead);
+    effects_[j]->apply(c.frame);
+  }
+  // The lead's truth is kept for the detector's tallies in detect().
+  lead_truth_ = lead.position;
+  return ms_since(t0);
+}
+
+double RenderedFrontend::detect(const slam::Estimator& est, eval::FrontendRecord& fr) {
+  double ms = 0;
+  for (std::size_t j = 0; j < cams_.size(); ++j) {
+    Cam& c = cams_[j];
+    // Where the estimate puts the lead in this image (estimated camera, commanded orientation).
+    const auto& rig = est.camera(static_cast<int>(j));
+    const Eigen::Vector3d p_est = rig.R_CW * (est.lead_position() - est.camera_position(static_cast<int>(j)));
+    std::optional<Eigen::Vector2d> predicted = c.model.project(p_est);
+    if (predicted && !c.model.in_image(*predicted, -100)) predicted.reset();
+
+    const auto t0 = Clock::now();
+    const cv::Mat grey = c.frame.gray();
+    cv::Mat bgr;
+    if (colour_lead_) cv::cvtColor(c.frame.rgb, bgr, cv::COLOR_RGB2BGR);
+    const auto det = lead_.detect(colour_lead_ ? bgr : grey, predicted);
+    c.lead.reset();
+    std::vector<vision::ExclusionBox> exclude;
+    if (det) {
+      c.lead = det->uv;
+      exclude.push_back(vision::exclusion_box(*det));
+    } else if (predicted) {
+      exclude.push_back(predicted_lead_box(*predicted, c.model.fx(), p_est.z(), scn_));
+    }
+    c.features = features_.detect(grey, exclude);
+    ms += ms_since(t0);
+    c.preds.clear();  // a camera whose landmarks are switched off tracks nothing this step
+    c.used.assign(c.features.size(), false);
+
+    // Tallies against the truth (evaluation only): in view when the reference point projects
+    // inside the image with room for the marker and the rendered depth there is the lead's.
+    ++fr.frames;
+    const Eigen::Vector3d p_true = c.true_pose.to_camera(lead_truth_);
+    const auto uv_true = c.model.project(p_true);
+    bool in_view = false;
+    if (uv_true && c.model.in_image(*uv_true, 15)) {
+      const auto d = vision::sample_depth(c.frame.depth, *uv_true);
+      in_view = d && std::abs(*d - p_true.z()) < 0.3;
+    }
+    if (in_view) ++fr.lead_in_view;
+    if (det) {
+      const double err = in_view ? (det->uv - *uv_true).norm() : INFINITY;
+      if (err <= fr.lead_match_px) {
+        ++fr.lead_detected;
+        fr.lead_error_px.push_back(err);
+      } else {
+        ++fr.lead_false;
+      }
+    }
+  }
+  return ms;
+}
+
+std::vector<LabelledCorrespondence> RenderedFrontend::track(
+    int cam, const std::vector<slam::LandmarkPrediction>& preds) {
+  Cam& c = cams_[cam];
+  c.preds.clear();
+  for (const auto& p : preds) c.preds.push_back({p.id, p.uv, p.S});
+  const auto tr = vision::track_landmarks(c.preds, c.features, store_, tracking_);
+  c.used = tr.keypoint_used;
+  std::vector<LabelledCorrespondence> out;
+  for (const auto& tc : tr.candidates) {
+    LabelledCorrespondence lc;
+    lc.c = {cam, tc.id, tc.uv};
+    lc.keypoint = tc.keypoint;
+    const auto it = truth_.find(tc.id);
+    // No truth (no rendered surface where it was first seen): counted as an outlier.
+    lc.outlier = it == truth_.end() || !it->second ||
+                 vision::label_landmark_observation(*it->second, tc.uv, c.model, c.true_pose,
+                                                    c.frame.depth)
+                         .label != vision::Label::Inlier;
+    out.push_back(lc);
+  }
+  return out;
+}
+
+void RenderedFrontend::accepted(const LabelledCorrespondence& lc, std::int64_t frame) {
+  const Cam& c = cams_[lc.c.cam];
+  store_.observe(lc.c.id, c.features.descriptors.row(lc.keypoint), frame);
+}
+
+std::vector<LabelledPair> RenderedFrontend::cross_match(int cam_a, int cam_b, int needed,
+                                                        const slam::Estimator& est) {
+  Cam& a = cams_[cam_a];
+  Cam& b = cams_[cam_b];
+  const auto free_a = vision::free_keypoints(a.features, a.used, a.preds);
+  const auto free_b = vision::free_keypoints(b.features, b.used, b.preds);
+  const vision::CameraView va{a.model, {est.camera(cam_a).R_CW, est.camera_position(cam_a)}};
+  const vision::CameraView vb{b.model, {est.camera(cam_b).R_CW, est.camera_position(cam_b)}};
+  const auto res = vision::match_across(a.features, free_a, va, b.features, free_b, vb, cross_);
+  std::vector<Eigen::Vector2d> ex_a, ex_b;
+  for (const auto& p : a.preds) ex_a.push_back(p.uv);
+  for (const auto& p : b.preds) ex_b.push_back(p.uv);
+  const auto chosen = vision::select_spread(res.matches, needed, a.model, ex_a, b.model, ex_b);
+  std::vector<LabelledPair> out;
+  for (const auto& m : chosen) {
+    LabelledPair lp;
+    lp.m = {cam_a, cam_b, m.uv_a, m.uv_b};
+    lp.keypoint_a = m.keypoint_a;
+    lp.outlier = vision::label_pixel_pair(m.uv_a, a.model, a.true_pose, a.frame.depth, m.uv_b,
+                                          b.model, b.true_pose, b.frame.depth)
+                     .label != vision::Label::Inlier;
+    out.push_back(lp);
+  }
+  return out;
+}
+
+std::vector<LabelledCorrespondence> RenderedFrontend::new_points(int cam, int needed) {
+  Cam& c = cams_[cam];
+  auto free = vision::free_keypoints(c.features, c.used, c.preds);
+  // Strongest corners first; select_spread with the same camera twice spreads single pixels.
+  std::stable_sort(free.begin(), free.end(), [&](int x, int y) {
+    return c.features.keypoints[x].response > c.features.keypoints[y].response;
+  });
+  std::vector<vision::CrossMatchCandidate> cand;
+  for (int i : free) {
+    vision::CrossMatchCandidate m;
+    m.keypoint_a = m.keypoint_b = i;
+    m.uv_a = m.uv_b = c.features.pixel(i);
+    cand.push_back(m);
+  }
+  std::vector<Eigen::Vector2d> existing;
+  for (const auto& p : c.preds) existing.push_back(p.uv);
+  std::vector<LabelledCorrespondence> out;
+  for (const auto& m : vision::select_spread(cand, needed, c.model, existing, c.model, existing)) {
+    LabelledCorrespondence lc;
+    lc.c = {cam, -1, m.uv_a};
+    lc.keypoint = m.keypoint_a;
+    out.push_back(lc);
+  }
+  return out;
+}
+
+std::optional<Eigen::Vector3d> RenderedFrontend::added(slam::LandmarkId id, int cam, int keypoint,
+                                                       const Eigen::Vector2d& uv,
+                                                       std::int64_t frame) {
+  const Cam& c = cams_[cam];
+  store_.add(id, c.features.descriptors.row(keypoint), frame);
+  auto truth = vision::back_project(uv, c.model, c.true_pose, c.frame.depth);
+  truth_[id] = truth;
+  return truth;
+}
+
+void RenderedFrontend::removed(slam::LandmarkId id) {
+  store_.remove(id);
+  truth_.erase(id);
+}
+
+}  // namespace wingman::app

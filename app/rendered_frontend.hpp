@@ -1,0 +1,113 @@
+// The rendered measurement source (`measurements: rendered`): each step renders every UAV camera
+// at its true pose, runs the vision frontend on the frames and hands the estimator what it
+// consumes (landmark candidates, lead pixels, cross-UAV pixel pairs, single-camera pixels), in
+// slam's types. Ground truth (true poses, rendered depth) is used only to label what the frontend
+// produced, for Table 3, the lead detector's figures and the landmarks' truth (DESIGN.md §7);
+// the frontend's own decisions see only images and estimated poses. Only app/ wires render,
+// vision and slam.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "eval/run_record.hpp"
+#include "render/gl_context.hpp"
+#include "render/renderer.hpp"
+#include "sim/scenario.hpp"
+#include "sim/truth.hpp"
+#include "slam/estimator.hpp"
+#include "vision/cross_match.hpp"
+#include "vision/descriptor_store.hpp"
+#include "vision/features.hpp"
+#include "vision/labelling.hpp"
+#include "vision/lead_detector.hpp"
+#include "vision/tracking.hpp"
+
+namespace wingman::render {
+class ImageEffects;
+}
+
+namespace wingman::app {
+
+// A landmark correspondence proposed by tracking, with its ground-truth label.
+struct LabelledCorrespondence {
+  slam::Correspondence c;
+  int keypoint = -1;
+  bool outlier = false;  // > 3 px from the true projection, occluded, or no truth
+};
+
+// A cross-UAV pixel pair for initialisation, with its label and what the store needs.
+struct LabelledPair {
+  slam::CrossMatch m;
+  int keypoint_a = -1;
+  bool outlier = false;
+};
+
+class RenderedFrontend {
+ public:
+  // cam_uav: the UAV index of each filter camera (all UAVs, or the single-UAV baseline's one).
+  RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, render::GlBackend backend);
+  ~RenderedFrontend();
+  RenderedFrontend(const RenderedFrontend&) = delete;
+  RenderedFrontend& operator=(const RenderedFrontend&) = delete;
+
+  std::string renderer_description() const;
+  std::string detector_name() const { return vision::to_string(features_.settings().kind); }
+
+  // Renders every camera at t (true pose, gimbal error included); returns ms spent.
+  double render(const sim::Truth& truth, double t);
+  // Lead detection (searched first around the estimate's projection) and features outside the
+  // lead's box, for every camera; updates the lead detector's tallies in `fr`. Returns ms spent.
+  double detect(const slam::Estimator& est, eval::FrontendRecord& fr);
+  std::optional<Eigen::Vector2d> lead_pixel(int cam) const { return cams_[cam].lead; }
+
+  // Tracking of the filter's predictions in camera `cam`, labelled against the truth.
+  std::vector<LabelledCorrespondence> track(int cam, const std::vector<slam::LandmarkPrediction>& preds);
+  // The filter accepted this correspondence: refresh the landmark's descriptor.
+  void accepted(const LabelledCorrespondence& c, std::int64_t frame);
+
+  // Cross-UAV matches of free features between two cameras (estimated poses), spread over the
+  // images, at most `needed`, labelled.
+  std::vector<LabelledPair> cross_match(int cam_a, int cam_b, int needed,
+                                        const slam::Estimator& est);
+  // Free features of one camera for single-camera initialisation, spread, at most `needed`.
+  std::vector<LabelledCorrespondence> new_points(int cam, int needed);
+
+  // A landmark was initialised from the feature `keypoint` of camera `cam` at `uv`: keep its
+  // descriptor, and its truth (back-projection through the true pose and rendered depth).
+  // Returns the truth, or nothing when the pixel has no rendered surface.
+  std::optional<Eigen::Vector3d> added(slam::LandmarkId id, int cam, int keypoint,
+                                       const Eigen::Vector2d& uv, std::int64_t frame);
+  void removed(slam::LandmarkId id);
+
+ private:
+  struct Cam {
+    geometry::PinholeCamera model;
+    render::Frame frame;
+    vision::CameraPose true_pose;
+    vision::Features features;
+    std::vector<vision::LandmarkPrediction> preds;  // this step's, for free features and spread
+    std::vector<bool> used;                         // keypoints taken by tracking
+    std::optional<Eigen::Vector2d> lead;
+  };
+  const sim::Scenario& scn_;
+  std::vector<int> cam_uav_;
+  std::unique_ptr<render::GlContext> ctx_;
+  std::unique_ptr<render::Renderer> renderer_;
+  std::vector<std::unique_ptr<render::ImageEffects>> effects_;
+  vision::FeatureExtractor features_;
+  vision::LeadDetector lead_;
+  vision::TrackingSettings tracking_;
+  vision::CrossMatchSettings cross_;
+  vision::DescriptorStore store_;
+  std::unordered_map<slam::LandmarkId, std::optional<Eigen::Vector3d>> truth_;
+  std::vector<Cam> cams_;
+  Eigen::Vector3d lead_truth_ = Eigen::Vector3d::Zero();  // this step's, for the tallies only
+  bool colour_lead_ = false;
+};
+
+}  // namespace wingman::app
