@@ -535,6 +535,14 @@ TEST(ScenarioModel, NamesRoundTrip) {
   EXPECT_STREQ(to_string(EstimatorMode::MultiUav), "multi");
   EXPECT_STREQ(to_string(EstimatorMode::SingleUav), "single");
   EXPECT_STREQ(to_string(MeasurementMode::Synthetic), "synthetic");
+  EXPECT_STREQ(to_string(MeasurementMode::Rendered), "rendered");
+}
+
+TEST(ScenarioYaml, RenderedMeasurementsParse) {
+  EXPECT_EQ(parse_scenarios("measurements: rendered\n", "scn.yaml").front().measurements,
+            MeasurementMode::Rendered);
+  EXPECT_EQ(parse_scenarios("measurements: synthetic\n", "scn.yaml").front().measurements,
+            MeasurementMode::Synthetic);
 }
 
 TEST(ScenarioModel, SensorsOfFollowsTable1) {
