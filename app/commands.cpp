@@ -21,6 +21,7 @@ int run_cli(int argc, char** argv) {
       add_montecarlo(cli),
       add_observability(cli),
       add_render(cli),
+      add_slam(cli),
   };
 
   try {

@@ -6,10 +6,12 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "app/rendered_frontend.hpp"
 #include "app/version.hpp"
+#include "datasets/dataset.hpp"
 #include "control/formation.hpp"
 #include "control/sliding_mode.hpp"
 #include "sim/closed_loop_truth.hpp"
@@ -69,6 +71,11 @@ double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
 struct LoopHooks {
   std::function<void(int k, double t)> advance;
   std::function<void(int k, double t, const slam::Estimator&, eval::StepRecord&)> control;
+  // Dataset replay: frames and sensor samples from the dataset, not the renderer and the
+  // synthetic source (a sample missing at step k is not fed).
+  FrameSource frames;
+  std::function<std::optional<Eigen::Vector3d>(int k)> gps;
+  std::function<std::optional<double>(int k, int uav)> altimeter, range;
 };
 
 // Synthetic mode: every measurement from `source`. Rendered mode: the visual ones from rendered
@@ -89,7 +96,9 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   }
   const int ncam = static_cast<int>(cam_uav.size());
   std::unique_ptr<RenderedFrontend> fe;
-  if (scn.measurements == sim::MeasurementMode::Rendered)
+  if (hooks.frames)
+    fe = std::make_unique<RenderedFrontend>(scn, cam_uav, hooks.frames);
+  else if (scn.measurements == sim::MeasurementMode::Rendered)
     fe = std::make_unique<RenderedFrontend>(scn, cam_uav, gl);
 
   std::vector<slam::CameraRig> rigs;
@@ -192,7 +201,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     const double t_predict = ms_since(t0);
     double t_render = 0, t_detect = 0, t_match = 0;
     if (fe) {
-      t_render = fe->render(truth, t);
+      t_render = fe->render(truth, k, t);
       for (int j = 0; j < ncam; ++j) est.set_camera_rotation(j, truth.commanded_R_CW());
       t_detect = fe->detect(est, rec.frontend);
     }
@@ -257,13 +266,27 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     }
 
     slam::SensorBatch batch;
-    if (scn.sensor_active(sim::Sensor::Gps, t, "lead")) batch.gps = source.gps(t);
+    if (scn.sensor_active(sim::Sensor::Gps, t, "lead")) {
+      if (!hooks.gps)
+        batch.gps = source.gps(t);
+      else if (auto g = hooks.gps(k))
+        batch.gps = *g;
+    }
     for (int j = 0; j < ncam; ++j) {
       const int u = cam_uav[j];
       const auto& name = scn.uavs[u].name;
-      if (scn.sensor_active(sim::Sensor::Altimeter, t, name))
-        batch.altimeter.emplace_back(j, source.altimeter(u, t));
-      if (scn.sensor_active(sim::Sensor::Range, t, name)) batch.range.emplace_back(j, source.range(u, t));
+      if (scn.sensor_active(sim::Sensor::Altimeter, t, name)) {
+        if (!hooks.altimeter)
+          batch.altimeter.emplace_back(j, source.altimeter(u, t));
+        else if (auto a = hooks.altimeter(k, u))
+          batch.altimeter.emplace_back(j, *a);
+      }
+      if (scn.sensor_active(sim::Sensor::Range, t, name)) {
+        if (!hooks.range)
+          batch.range.emplace_back(j, source.range(u, t));
+        else if (auto r = hooks.range(k, u))
+          batch.range.emplace_back(j, *r);
+      }
     }
     est.update_sensors(batch);
     const double t_update = ms_since(t0) - t_track;
@@ -400,6 +423,11 @@ control::SlidingModeSettings controller_settings(const sim::ControlSpec& c) {
 
 // Section 7.3: the estimator's positions and the AHRS yaw feed one sliding-mode controller per
 // UAV; its command, plus Delta_g (eq. 58), drives eq. 53 until the next step (ZOH, Fig. 7).
+std::string fmt_missing(const datasets::Dataset& ds, const std::string& agent, int needed) {
+  return ds.root.string() + "/" + agent + ": fewer frames or camera poses than the " +
+         std::to_string(needed) + " steps to replay";
+}
+
 eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& progress,
                                 const StateObserver& observer, render::GlBackend gl) {
   if (scn.estimator.mode != sim::EstimatorMode::MultiUav)
@@ -487,6 +515,71 @@ eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progre
 }
 
 }  // namespace
+
+eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
+                           const ProgressFn& progress) {
+  if (scn.closed_loop())
+    throw std::invalid_argument(ds.root.string() +
+                                ": a dataset holds an open-loop flight; its scenario has a control: section");
+  const sim::OpenLoopTruth truth(scn);
+  sim::SyntheticSource source(scn, truth);  // unused for measurements: everything is replayed
+  const int n = static_cast<int>(scn.uavs.size());
+  std::vector<const datasets::AgentData*> agent(n);
+  for (int u = 0; u < n; ++u) agent[u] = &ds.agent(scn.uavs[u].name);  // throws naming the file
+  const auto& lead = ds.agent("lead");
+  const int steps = scn.num_steps();
+  for (int u = 0; u < n; ++u) {
+    const auto& a = *agent[u];
+    if (static_cast<int>(a.frames.size()) < steps + 1 ||
+        static_cast<int>(a.camera_pose.size()) < steps + 1)
+      throw std::invalid_argument(fmt_missing(ds, a.name, steps + 1));
+    // The frontend labels against the scenario's truth: it must be the truth the frames show.
+    for (int k : {0, steps / 2, steps}) {
+      const Eigen::Vector3d d = a.camera_pose[k].p - truth.camera(u, k * scn.dt()).position;
+      if (d.norm() > 1e-3)
+        throw std::invalid_argument(ds.root.string() + "/" + a.name +
+                                    "/groundtruth/cam0.csv: camera positions differ from the truth "
+                                    "of the dataset's scenario.yaml (" +
+                                    std::to_string(d.norm()) + " m at step " + std::to_string(k) + ")");
+    }
+  }
+  // Filter camera index -> UAV index, as run_loop numbers them.
+  std::vector<int> cam_uav;
+  if (scn.estimator.mode == sim::EstimatorMode::SingleUav)
+    cam_uav.push_back(scn.uav_index(scn.estimator.single_uav));
+  else
+    for (int u = 0; u < n; ++u) cam_uav.push_back(u);
+
+  auto at = [&](const auto& samples, int k) -> const auto* {
+    const std::int64_t t_ns = datasets::step_ns(k, scn.rate);
+    auto it = std::lower_bound(samples.begin(), samples.end(), t_ns,
+                               [](const auto& s, std::int64_t v) { return s.t_ns < v; });
+    return it != samples.end() && it->t_ns == t_ns ? &*it : nullptr;
+  };
+  LoopHooks hooks;
+  hooks.frames = [&](int cam, int k) {
+    const auto& a = *agent[cam_uav[cam]];
+    render::Frame f;
+    cv::Mat img = ds.load_image(a.name, a.frames[k]);
+    if (img.channels() == 1) cv::cvtColor(img, img, cv::COLOR_GRAY2RGB);
+    f.rgb = img;
+    f.depth = ds.load_depth(a.name, a.frames[k]);
+    return f;
+  };
+  hooks.gps = [&](int k) -> std::optional<Eigen::Vector3d> {
+    if (const auto* s = at(lead.gps, k)) return s->value;
+    return std::nullopt;
+  };
+  hooks.altimeter = [&](int k, int u) -> std::optional<double> {
+    if (const auto* s = at(agent[u]->altimeter, k)) return s->value;
+    return std::nullopt;
+  };
+  hooks.range = [&](int k, int u) -> std::optional<double> {
+    if (const auto* s = at(agent[u]->range, k)) return s->value;
+    return std::nullopt;
+  };
+  return run_loop(scn, truth, source, progress, {}, hooks, render::GlBackend::Auto);
+}
 
 eval::RunRecord run_scenario(const sim::Scenario& scn, render::GlBackend gl,
                              const ProgressFn& progress, const StateObserver& observer) {

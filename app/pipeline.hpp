@@ -11,6 +11,10 @@
 #include "sim/scenario.hpp"
 #include "slam/state.hpp"
 
+namespace wingman::datasets {
+struct Dataset;
+}
+
 namespace wingman::app {
 
 // Called after each step with (steps done, steps in total).
@@ -25,6 +29,11 @@ using StateObserver = std::function<void(int, const slam::FilterState&)>;
 // synthetic projections, or frames rendered with an OpenGL context of backend `gl` (rendered).
 eval::RunRecord run_scenario(const sim::Scenario& scn, render::GlBackend gl = render::GlBackend::Auto,
                              const ProgressFn& progress = {}, const StateObserver& observer = {});
+// Replays a dataset written by `wingman render` through the same frontend and estimator: its
+// frames, GPS/altimeter/range samples; its scenario (the dataset's scenario.yaml, the variant and
+// seed it was rendered with) gives the truth, checked against the dataset's camera poses.
+eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
+                           const ProgressFn& progress = {});
 // run_scenario with the automatic GL backend (a synthetic scenario never makes a context).
 eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress = {},
                               const StateObserver& observer = {});

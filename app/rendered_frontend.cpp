@@ -73,11 +73,25 @@ RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> ca
   }
 }
 
+RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav,
+                                   FrameSource frames)
+    : scn_(scn), cam_uav_(std::move(cam_uav)), frames_(std::move(frames)), lead_(lead_settings(scn)) {
+  colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
+  cross_.min_parallax_deg = scn.estimator.min_parallax_deg;
+  for (int u : cam_uav_) {
+    Cam c;
+    c.model = scn.uavs[u].camera.camera();
+    cams_.push_back(std::move(c));
+  }
+}
+
 RenderedFrontend::~RenderedFrontend() = default;
 
-std::string RenderedFrontend::renderer_description() const { return ctx_->description(); }
+std::string RenderedFrontend::renderer_description() const {
+  return ctx_ ? ctx_->description() : std::string("dataset replay");
+}
 
-double RenderedFrontend::render(const sim::Truth& truth, double t) {
+double RenderedFrontend::render(const sim::Truth& truth, int k, double t) {
   const auto t0 = Clock::now();
   render::LeadPose lead = render::lead_pose(scn_, t);
   lead.position = truth.lead(t).position;
@@ -85,8 +99,12 @@ double RenderedFrontend::render(const sim::Truth& truth, double t) {
   for (std::size_t j = 0; j < cams_.size(); ++j) {
     Cam& c = cams_[j];
     c.true_pose = {R_CW, truth.camera(cam_uav_[j], t).position};
-    c.frame = renderer_->render({c.model, R_CW, c.true_pose.position}, lead);
-    effects_[j]->apply(c.frame);
+    if (frames_) {
+      c.frame = frames_(static_cast<int>(j), k);
+    } else {
+      c.frame = renderer_->render({c.model, R_CW, c.true_pose.position}, lead);
+      effects_[j]->apply(c.frame);
+    }
   }
   // The lead's truth is kept for the detector's tallies in detect().
   lead_truth_ = lead.position;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <unordered_map>
@@ -47,10 +48,15 @@ struct LabelledPair {
   bool outlier = false;
 };
 
+// Frames of filter camera `cam` at step k from somewhere other than the renderer (a dataset).
+using FrameSource = std::function<render::Frame(int cam, int k)>;
+
 class RenderedFrontend {
  public:
   // cam_uav: the UAV index of each filter camera (all UAVs, or the single-UAV baseline's one).
   RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, render::GlBackend backend);
+  // Replay: frames from `frames` (already with their image effects), no GL context.
+  RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, FrameSource frames);
   ~RenderedFrontend();
   RenderedFrontend(const RenderedFrontend&) = delete;
   RenderedFrontend& operator=(const RenderedFrontend&) = delete;
@@ -58,8 +64,9 @@ class RenderedFrontend {
   std::string renderer_description() const;
   std::string detector_name() const { return vision::to_string(features_.settings().kind); }
 
-  // Renders every camera at t (true pose, gimbal error included); returns ms spent.
-  double render(const sim::Truth& truth, double t);
+  // Renders (or loads) every camera's frame of step k at t (true pose, gimbal error included);
+  // returns ms spent.
+  double render(const sim::Truth& truth, int k, double t);
   // Lead detection (searched first around the estimate's projection) and features outside the
   // lead's box, for every camera; updates the lead detector's tallies in `fr`. Returns ms spent.
   double detect(const slam::Estimator& est, eval::FrontendRecord& fr);
@@ -96,6 +103,7 @@ class RenderedFrontend {
   };
   const sim::Scenario& scn_;
   std::vector<int> cam_uav_;
+  FrameSource frames_;
   std::unique_ptr<render::GlContext> ctx_;
   std::unique_ptr<render::Renderer> renderer_;
   std::vector<std::unique_ptr<render::ImageEffects>> effects_;

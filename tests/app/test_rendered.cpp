@@ -121,5 +121,33 @@ TEST(RenderedPipeline, MissingLeadModelIsAnErrorNamingTheFile) {
   EXPECT_FALSE(fs::exists(dir / "out" / "metrics.json"));
 }
 
+// `wingman render` then `wingman slam`: the replay runs the same frontend and estimator on the
+// dataset's frames and samples and writes the same metrics, with the frontend's figures.
+TEST(RenderedPipeline, SlamReplaysARenderedDataset) {
+  std::string why;
+  if (!gl_available(&why)) GTEST_SKIP() << why;
+  TempDir dir;
+  const fs::path ds = dir / "ds";
+  auto r = run_wingman({"render", kRenderedSmoke.string(), "--variant", "multi", "--duration", "1",
+                        "--quiet", "--out", ds.string()},
+                       dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_wingman({"slam", ds.string(), "--no-plots", "--quiet", "--out", (dir / "res").string()},
+                  dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string metrics = read_file(dir / "res" / "metrics.json");
+  EXPECT_THAT(metrics, ::testing::HasSubstr("\"lead_detection_rate\": 1.0"));
+  EXPECT_THAT(metrics, ::testing::HasSubstr("\"render\""));
+  EXPECT_TRUE(fs::exists(dir / "res" / "landmarks.csv"));
+
+  // A frame gone from the dataset: an error naming it, exit 2, no results.
+  fs::remove(ds / "uav2" / "cam0" / "data" / "100000000.png");
+  r = run_wingman({"slam", ds.string(), "--no-plots", "--quiet", "--out", (dir / "res2").string()},
+                  dir.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, ::testing::HasSubstr("100000000.png"));
+  EXPECT_FALSE(fs::exists(dir / "res2" / "metrics.json"));
+}
+
 }  // namespace
 }  // namespace wingman::app::test

@@ -1,0 +1,107 @@
+// `wingman slam <dataset-dir>`: replays a dataset written by `wingman render` through the same
+// vision frontend and estimator as `measurements: rendered`, into a results directory with the
+// same metrics. The scenario is the dataset's own scenario.yaml, with the variant and seed the
+// dataset records (--variant picks another variant's estimator settings).
+#include "app/subcommand.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "app/pipeline.hpp"
+#include "app/progress.hpp"
+#include "datasets/dataset.hpp"
+#include "eval/metrics.hpp"
+#include "eval/plots.hpp"
+#include "eval/results_dir.hpp"
+#include "eval/writers.hpp"
+#include "sim/scenario.hpp"
+
+namespace fs = std::filesystem;
+
+namespace wingman::app {
+
+namespace {
+
+struct SlamOptions {
+  std::string dataset;
+  std::string out;
+  std::string variant;
+  bool no_plots = false;
+  bool quiet = false;
+};
+
+int slam_command(const SlamOptions& o) {
+  datasets::Dataset ds;
+  try {
+    ds = datasets::read_dataset(o.dataset);
+  } catch (const std::runtime_error& e) {  // DatasetError names the file
+    throw UsageError(e.what());
+  }
+  const fs::path scn_path = fs::path(o.dataset) / "scenario.yaml";
+  if (!fs::exists(scn_path)) throw UsageError(scn_path.string() + ": missing (written by wingman render)");
+  auto scenarios = sim::load_scenarios(scn_path.string());
+  const std::string want = o.variant.empty() ? ds.info.variant : o.variant;
+  sim::Scenario scn = scenarios.front();
+  if (!want.empty()) {
+    auto it = std::find_if(scenarios.begin(), scenarios.end(),
+                           [&](const sim::Scenario& s) { return s.variant == want; });
+    if (it == scenarios.end())
+      throw UsageError(fmt::format("{}: no variant '{}'", scn_path.string(), want));
+    scn = *it;
+  }
+  scn.seed = ds.info.seed;
+  scn.measurements = sim::MeasurementMode::Rendered;
+  // A shortened dataset (render --frames/--duration) replays what it has.
+  const int frames = ds.agents.empty() ? 0 : static_cast<int>(ds.agent(scn.uavs.front().name).frames.size());
+  if (frames < 2) throw UsageError(fmt::format("{}: fewer than 2 frames to replay", o.dataset));
+  scn.duration = std::min(scn.duration, (frames - 1) / scn.rate);
+  if (!o.no_plots && !eval::gnuplot_available())
+    throw UsageError("gnuplot with the pngcairo terminal was not found; install it or pass --no-plots");
+
+  const fs::path out = o.out.empty() ? fs::path("results") / (scn.name + "_replay") : fs::path(o.out);
+  std::optional<eval::ResultsDir> staged;
+  try {
+    staged.emplace(out);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(e.what());
+  }
+  ProgressLine progress(fmt::format("[slam {}]", scn.name), o.quiet);
+  eval::RunRecord rec;
+  try {
+    rec = run_replay(scn, ds, [&](int k, int n) { progress.update(k, n, "steps"); });
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  progress.finish();
+  const eval::Metrics metrics = eval::compute_metrics(rec);
+  eval::write_results(metrics, rec, staged->staging());
+  if (!o.no_plots) eval::write_plots(rec, staged->staging());
+  fs::copy_file(scn_path, staged->staging() / "scenario.yaml");
+  staged->commit();
+  if (!o.quiet) fmt::print("{}\nresults: {}\n", eval::format_summary(metrics, rec), out.string());
+  return 0;
+}
+
+}  // namespace
+
+Subcommand add_slam(CLI::App& parent) {
+  auto o = std::make_shared<SlamOptions>();
+  auto* cmd = parent.add_subcommand(
+      "slam", "Replay a dataset written by `wingman render` through the vision frontend and the "
+              "estimator, into a results directory (the same metrics as `wingman run`)");
+  cmd->add_option("dataset", o->dataset, "Dataset directory")->required();
+  cmd->add_option("--out,-o", o->out, "Results directory (default: results/<scenario>_replay)");
+  cmd->add_option("--variant", o->variant,
+                  "Estimator settings of this variant of the dataset's scenario (default: the "
+                  "variant it was rendered with, else the first)");
+  cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
+  cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
+  return {cmd, [o] { return slam_command(*o); }};
+}
+
+}  // namespace wingman::app
