@@ -14,6 +14,7 @@
 
 #include "app/pipeline.hpp"
 #include "app/progress.hpp"
+#include "app/replay.hpp"
 #include "datasets/dataset.hpp"
 #include "eval/metrics.hpp"
 #include "eval/plots.hpp"
@@ -36,30 +37,10 @@ struct SlamOptions {
 };
 
 int slam_command(const SlamOptions& o) {
-  datasets::Dataset ds;
-  try {
-    ds = datasets::read_dataset(o.dataset);
-  } catch (const std::runtime_error& e) {  // DatasetError names the file
-    throw UsageError(e.what());
-  }
-  const fs::path scn_path = fs::path(o.dataset) / "scenario.yaml";
-  if (!fs::exists(scn_path)) throw UsageError(scn_path.string() + ": missing (written by wingman render)");
-  auto scenarios = sim::load_scenarios(scn_path.string());
-  const std::string want = o.variant.empty() ? ds.info.variant : o.variant;
-  sim::Scenario scn = scenarios.front();
-  if (!want.empty()) {
-    auto it = std::find_if(scenarios.begin(), scenarios.end(),
-                           [&](const sim::Scenario& s) { return s.variant == want; });
-    if (it == scenarios.end())
-      throw UsageError(fmt::format("{}: no variant '{}'", scn_path.string(), want));
-    scn = *it;
-  }
-  scn.seed = ds.info.seed;
-  scn.measurements = sim::MeasurementMode::Rendered;
-  // A shortened dataset (render --frames/--duration) replays what it has.
-  const int frames = ds.agents.empty() ? 0 : static_cast<int>(ds.agent(scn.uavs.front().name).frames.size());
-  if (frames < 2) throw UsageError(fmt::format("{}: fewer than 2 frames to replay", o.dataset));
-  scn.duration = std::min(scn.duration, (frames - 1) / scn.rate);
+  const Replay replay = load_replay(o.dataset, o.variant);
+  const datasets::Dataset& ds = replay.dataset;
+  const sim::Scenario& scn = replay.scenario;
+  const fs::path& scn_path = replay.scenario_path;
   if (!o.no_plots && !eval::gnuplot_available())
     throw UsageError("gnuplot with the pngcairo terminal was not found; install it or pass --no-plots");
 

@@ -22,6 +22,7 @@ int run_cli(int argc, char** argv) {
       add_observability(cli),
       add_render(cli),
       add_slam(cli),
+      add_bench_frontend(cli),
   };
 
   try {

@@ -74,6 +74,7 @@ struct LoopHooks {
   // Dataset replay: frames and sensor samples from the dataset, not the renderer and the
   // synthetic source (a sample missing at step k is not fed).
   FrameSource frames;
+  vision::FeatureSettings features{};
   std::function<std::optional<Eigen::Vector3d>(int k)> gps;
   std::function<std::optional<double>(int k, int uav)> altimeter, range;
 };
@@ -97,7 +98,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   const int ncam = static_cast<int>(cam_uav.size());
   std::unique_ptr<RenderedFrontend> fe;
   if (hooks.frames)
-    fe = std::make_unique<RenderedFrontend>(scn, cam_uav, hooks.frames);
+    fe = std::make_unique<RenderedFrontend>(scn, cam_uav, hooks.frames, hooks.features);
   else if (scn.measurements == sim::MeasurementMode::Rendered)
     fe = std::make_unique<RenderedFrontend>(scn, cam_uav, gl);
 
@@ -517,7 +518,7 @@ eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progre
 }  // namespace
 
 eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
-                           const ProgressFn& progress) {
+                           const ProgressFn& progress, const vision::FeatureSettings& features) {
   if (scn.closed_loop())
     throw std::invalid_argument(ds.root.string() +
                                 ": a dataset holds an open-loop flight; its scenario has a control: section");
@@ -557,6 +558,7 @@ eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds
     return it != samples.end() && it->t_ns == t_ns ? &*it : nullptr;
   };
   LoopHooks hooks;
+  hooks.features = features;
   hooks.frames = [&](int cam, int k) {
     const auto& a = *agent[cam_uav[cam]];
     render::Frame f;

@@ -10,6 +10,7 @@
 #include "render/gl_context.hpp"
 #include "sim/scenario.hpp"
 #include "slam/state.hpp"
+#include "vision/features.hpp"
 
 namespace wingman::datasets {
 struct Dataset;
@@ -33,7 +34,8 @@ eval::RunRecord run_scenario(const sim::Scenario& scn, render::GlBackend gl = re
 // frames, GPS/altimeter/range samples; its scenario (the dataset's scenario.yaml, the variant and
 // seed it was rendered with) gives the truth, checked against the dataset's camera poses.
 eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
-                           const ProgressFn& progress = {});
+                           const ProgressFn& progress = {},
+                           const vision::FeatureSettings& features = {});
 // run_scenario with the automatic GL backend (a synthetic scenario never makes a context).
 eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress = {},
                               const StateObserver& observer = {});

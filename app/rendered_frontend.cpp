@@ -74,8 +74,12 @@ RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> ca
 }
 
 RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav,
-                                   FrameSource frames)
-    : scn_(scn), cam_uav_(std::move(cam_uav)), frames_(std::move(frames)), lead_(lead_settings(scn)) {
+                                   FrameSource frames, const vision::FeatureSettings& features)
+    : scn_(scn),
+      cam_uav_(std::move(cam_uav)),
+      frames_(std::move(frames)),
+      features_(features),
+      lead_(lead_settings(scn)) {
   colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
   cross_.min_parallax_deg = scn.estimator.min_parallax_deg;
   for (int u : cam_uav_) {

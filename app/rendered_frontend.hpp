@@ -55,8 +55,10 @@ class RenderedFrontend {
  public:
   // cam_uav: the UAV index of each filter camera (all UAVs, or the single-UAV baseline's one).
   RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, render::GlBackend backend);
-  // Replay: frames from `frames` (already with their image effects), no GL context.
-  RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, FrameSource frames);
+  // Replay: frames from `frames` (already with their image effects), no GL context; features
+  // as `features` says (bench-frontend compares detectors).
+  RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, FrameSource frames,
+                   const vision::FeatureSettings& features = {});
   ~RenderedFrontend();
   RenderedFrontend(const RenderedFrontend&) = delete;
   RenderedFrontend& operator=(const RenderedFrontend&) = delete;

@@ -27,6 +27,7 @@ Subcommand add_montecarlo(CLI::App& parent);     // app/cmd_montecarlo.cpp
 Subcommand add_observability(CLI::App& parent);  // app/cmd_observability.cpp
 Subcommand add_render(CLI::App& parent);         // app/cmd_render.cpp
 Subcommand add_slam(CLI::App& parent);           // app/cmd_slam.cpp
+Subcommand add_bench_frontend(CLI::App& parent); // app/cmd_bench_frontend.cpp
 // Further subcommands declare their add_<name>() here.
 
 }  // namespace wingman::app

@@ -121,9 +121,9 @@ TEST(RenderedPipeline, MissingLeadModelIsAnErrorNamingTheFile) {
   EXPECT_FALSE(fs::exists(dir / "out" / "metrics.json"));
 }
 
-// `wingman render` then `wingman slam`: the replay runs the same frontend and estimator on the
+// `wingman render` then `wingman slam` and `wingman bench-frontend`: the replay runs the same frontend and estimator on the
 // dataset's frames and samples and writes the same metrics, with the frontend's figures.
-TEST(RenderedPipeline, SlamReplaysARenderedDataset) {
+TEST(RenderedPipeline, SlamAndBenchFrontendReplayARenderedDataset) {
   std::string why;
   if (!gl_available(&why)) GTEST_SKIP() << why;
   TempDir dir;
@@ -139,6 +139,14 @@ TEST(RenderedPipeline, SlamReplaysARenderedDataset) {
   EXPECT_THAT(metrics, ::testing::HasSubstr("\"lead_detection_rate\": 1.0"));
   EXPECT_THAT(metrics, ::testing::HasSubstr("\"render\""));
   EXPECT_TRUE(fs::exists(dir / "res" / "landmarks.csv"));
+
+  // bench-frontend on the same dataset: one row per detector asked for.
+  r = run_wingman({"bench-frontend", ds.string(), "--detector", "orb", "--detector", "gftt_orb",
+                   "--quiet"},
+                  dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, ::testing::ContainsRegex("\norb +[0-9.]+ +[0-9.]+ +[0-9.]+%"));
+  EXPECT_THAT(r.output, ::testing::ContainsRegex("\ngftt_orb +[0-9.]+ +[0-9.]+ +[0-9.]+%"));
 
   // A frame gone from the dataset: an error naming it, exit 2, no results.
   fs::remove(ds / "uav2" / "cam0" / "data" / "100000000.png");

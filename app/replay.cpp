@@ -1,0 +1,42 @@
+#include "app/replay.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+
+#include "app/subcommand.hpp"
+
+namespace wingman::app {
+
+Replay load_replay(const std::string& dir, const std::string& variant) {
+  Replay r;
+  try {
+    r.dataset = datasets::read_dataset(dir);
+  } catch (const std::runtime_error& e) {  // DatasetError names the file
+    throw UsageError(e.what());
+  }
+  r.scenario_path = std::filesystem::path(dir) / "scenario.yaml";
+  if (!std::filesystem::exists(r.scenario_path))
+    throw UsageError(r.scenario_path.string() + ": missing (wingman render writes it)");
+  auto scenarios = sim::load_scenarios(r.scenario_path.string());
+  const std::string want = variant.empty() ? r.dataset.info.variant : variant;
+  r.scenario = scenarios.front();
+  if (!want.empty()) {
+    auto it = std::find_if(scenarios.begin(), scenarios.end(),
+                           [&](const sim::Scenario& s) { return s.variant == want; });
+    if (it == scenarios.end())
+      throw UsageError(fmt::format("{}: no variant '{}'", r.scenario_path.string(), want));
+    r.scenario = *it;
+  }
+  sim::Scenario& scn = r.scenario;
+  scn.seed = r.dataset.info.seed;
+  scn.measurements = sim::MeasurementMode::Rendered;
+  // A shortened dataset (render --frames/--duration) replays what it has.
+  const auto& first = r.dataset.agent(scn.uavs.front().name);
+  const int frames = static_cast<int>(first.frames.size());
+  if (frames < 2) throw UsageError(fmt::format("{}: fewer than 2 frames to replay", dir));
+  scn.duration = std::min(scn.duration, (frames - 1) / scn.rate);
+  return r;
+}
+
+}  // namespace wingman::app

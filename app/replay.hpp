@@ -1,0 +1,24 @@
+// Loading a dataset written by `wingman render` for a replay (`wingman slam`, `wingman
+// bench-frontend`): the dataset, validated, and the scenario it was rendered from (its own
+// scenario.yaml, with the dataset's variant and seed), shortened to the frames it holds.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "datasets/dataset.hpp"
+#include "sim/scenario.hpp"
+
+namespace wingman::app {
+
+struct Replay {
+  datasets::Dataset dataset;
+  sim::Scenario scenario;
+  std::filesystem::path scenario_path;  // DIR/scenario.yaml
+};
+
+// `variant` empty: the one the dataset was rendered with (else the first). Throws UsageError
+// naming the file for a dataset or scenario that cannot be used.
+Replay load_replay(const std::string& dir, const std::string& variant);
+
+}  // namespace wingman::app
