@@ -31,6 +31,7 @@ struct RunOptions {
   std::optional<std::uint64_t> seed;
   std::vector<std::string> variants;
   std::string gl = "auto";
+  std::string video;
   bool no_plots = false;
   bool quiet = false;
 };
@@ -80,7 +81,15 @@ int run_command(const RunOptions& o) {
     ProgressLine progress(fmt::format("[{}]", label), o.quiet);
     eval::RunRecord rec;
     try {
-      rec = run_scenario(scn, gl, [&](int k, int n) { progress.update(k, n, "steps"); });
+      std::string video = o.video;
+      if (!video.empty() && scenarios.size() > 1) {  // one file per variant: FILE_<variant>.avi
+        const fs::path v(video);
+        video = (v.parent_path() / (v.stem().string() + "_" + scn.variant + v.extension().string())).string();
+      }
+      if (!video.empty() && scn.measurements != sim::MeasurementMode::Rendered)
+        throw UsageError("--video needs a scenario with measurements: rendered");
+      rec = run_scenario(scn, RenderedOptions(gl, video),
+                         [&](int k, int n) { progress.update(k, n, "steps"); });
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());  // a world or frontend setting the scenario got wrong
     }
@@ -126,6 +135,10 @@ Subcommand add_run(CLI::App& parent) {
   cmd->add_option("--gl", o->gl,
                   "OpenGL backend for rendered scenarios: auto (EGL, then OSMesa), egl or osmesa")
       ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
+  cmd->add_option("--video", o->video,
+                  "Rendered scenarios: write both cameras side by side with tracked landmarks, "
+                  "new matches, rejected correspondences and the lead detection (MJPG AVI; one "
+                  "file per variant, FILE_<variant>.avi, when several run)");
   cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return run_command(*o); }};

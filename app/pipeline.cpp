@@ -84,7 +84,7 @@ struct LoopHooks {
 eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
                          sim::SyntheticSource& source, const ProgressFn& progress,
                          const StateObserver& observer, const LoopHooks& hooks,
-                         render::GlBackend gl) {
+                         const RenderedOptions& ro) {
   const auto wall0 = Clock::now();
   const bool single = scn.estimator.mode == sim::EstimatorMode::SingleUav;
 
@@ -100,7 +100,8 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   if (hooks.frames)
     fe = std::make_unique<RenderedFrontend>(scn, cam_uav, hooks.frames, hooks.features);
   else if (scn.measurements == sim::MeasurementMode::Rendered)
-    fe = std::make_unique<RenderedFrontend>(scn, cam_uav, gl);
+    fe = std::make_unique<RenderedFrontend>(scn, cam_uav, ro.gl);
+  if (fe && !ro.video.empty()) fe->open_video(ro.video);
 
   std::vector<slam::CameraRig> rigs;
   std::vector<slam::AgentInit> cam_init;
@@ -391,6 +392,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
       if (auto it = lm_record.find(id); it != lm_record.end()) rec.landmarks[it->second].t_removed = t;
     }
     const double t_init = ms_since(t0) - t_cross;
+    if (fe) fe->write_video_frame(t);
     t_match += t_cross;
 
     record_step(k, t, visible, static_cast<int>(cands.size()), accepted, initialised, t_predict,
@@ -430,7 +432,7 @@ std::string fmt_missing(const datasets::Dataset& ds, const std::string& agent, i
 }
 
 eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& progress,
-                                const StateObserver& observer, render::GlBackend gl) {
+                                const StateObserver& observer, const RenderedOptions& ro) {
   if (scn.estimator.mode != sim::EstimatorMode::MultiUav)
     throw std::invalid_argument("closed loop needs the multi-UAV estimator");
   sim::ClosedLoopTruth truth(scn);
@@ -501,7 +503,7 @@ eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& prog
     }
   };
 
-  eval::RunRecord rec = run_loop(scn, truth, source, progress, observer, hooks, gl);
+  eval::RunRecord rec = run_loop(scn, truth, source, progress, observer, hooks, ro);
   rec.closed_loop = true;
   for (const auto& u : scn.uavs) rec.formation_uavs.push_back(u.name);
   rec.settling_time = scn.control.settling_time;
@@ -509,10 +511,10 @@ eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& prog
 }
 
 eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progress,
-                              const StateObserver& observer, render::GlBackend gl) {
+                              const StateObserver& observer, const RenderedOptions& ro) {
   const sim::OpenLoopTruth truth(scn);
   sim::SyntheticSource source(scn, truth);
-  return run_loop(scn, truth, source, progress, observer, {}, gl);
+  return run_loop(scn, truth, source, progress, observer, {}, ro);
 }
 
 }  // namespace
@@ -580,18 +582,18 @@ eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds
     if (const auto* s = at(agent[u]->range, k)) return s->value;
     return std::nullopt;
   };
-  return run_loop(scn, truth, source, progress, {}, hooks, render::GlBackend::Auto);
+  return run_loop(scn, truth, source, progress, {}, hooks, RenderedOptions{});
 }
 
-eval::RunRecord run_scenario(const sim::Scenario& scn, render::GlBackend gl,
+eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& ro,
                              const ProgressFn& progress, const StateObserver& observer) {
-  return scn.closed_loop() ? run_closed_loop(scn, progress, observer, gl)
-                           : run_open_loop(scn, progress, observer, gl);
+  return scn.closed_loop() ? run_closed_loop(scn, progress, observer, ro)
+                           : run_open_loop(scn, progress, observer, ro);
 }
 
 eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress,
                               const StateObserver& observer) {
-  return run_scenario(scn, render::GlBackend::Auto, progress, observer);
+  return run_scenario(scn, RenderedOptions{}, progress, observer);
 }
 
 }  // namespace wingman::app

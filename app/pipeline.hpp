@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "eval/run_record.hpp"
 #include "render/gl_context.hpp"
@@ -27,8 +28,14 @@ using StateObserver = std::function<void(int, const slam::FilterState&)>;
 // Open loop (truth known in advance), or closed loop when the scenario has a control: section:
 // then the UAVs fly the sliding-mode controller's commands computed from the estimates (section 6).
 // The scenario's `measurements:` mode decides where the visual measurements come from:
-// synthetic projections, or frames rendered with an OpenGL context of backend `gl` (rendered).
-eval::RunRecord run_scenario(const sim::Scenario& scn, render::GlBackend gl = render::GlBackend::Auto,
+// synthetic projections, or frames rendered with an OpenGL context of backend `rendered.gl`.
+struct RenderedOptions {
+  RenderedOptions(render::GlBackend backend = render::GlBackend::Auto, std::string video_path = {})
+      : gl(backend), video(std::move(video_path)) {}
+  render::GlBackend gl;
+  std::string video;  // non-empty: both cameras side by side with what the frontend did, per step
+};
+eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& rendered = {},
                              const ProgressFn& progress = {}, const StateObserver& observer = {});
 // Replays a dataset written by `wingman render` through the same frontend and estimator: its
 // frames, GPS/altimeter/range samples; its scenario (the dataset's scenario.yaml, the variant and

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -44,6 +45,12 @@ vision::ExclusionBox predicted_lead_box(const Eigen::Vector2d& uv, double fx, do
                                         const sim::Scenario& scn) {
   const double half = std::max(20.0, 0.5 * 2.0 * scn.world.lead.height * fx / std::max(depth, 1.0));
   return {uv, half, half};
+}
+
+std::string fmt_label(const std::string& name, double t) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%s  t = %.1f s", name.c_str(), t);
+  return buf;
 }
 
 }  // namespace
@@ -140,6 +147,9 @@ double RenderedFrontend::detect(const slam::Estimator& est, eval::FrontendRecord
     }
     c.features = features_.detect(grey, exclude);
     ms += ms_since(t0);
+    c.tracked.clear();
+    c.accepted.clear();
+    c.fresh.clear();
     c.preds.clear();  // a camera whose landmarks are switched off tracks nothing this step
     c.used.assign(c.features.size(), false);
 
@@ -179,6 +189,7 @@ std::vector<LabelledCorrespondence> RenderedFrontend::track(
     LabelledCorrespondence lc;
     lc.c = {cam, tc.id, tc.uv};
     lc.keypoint = tc.keypoint;
+    c.tracked.push_back(tc.uv);
     const auto it = truth_.find(tc.id);
     // No truth (no rendered surface where it was first seen): counted as an outlier.
     lc.outlier = it == truth_.end() || !it->second ||
@@ -191,7 +202,8 @@ std::vector<LabelledCorrespondence> RenderedFrontend::track(
 }
 
 void RenderedFrontend::accepted(const LabelledCorrespondence& lc, std::int64_t frame) {
-  const Cam& c = cams_[lc.c.cam];
+  Cam& c = cams_[lc.c.cam];
+  c.accepted.push_back(lc.c.uv);
   store_.observe(lc.c.id, c.features.descriptors.row(lc.keypoint), frame);
 }
 
@@ -213,6 +225,8 @@ std::vector<LabelledPair> RenderedFrontend::cross_match(int cam_a, int cam_b, in
     LabelledPair lp;
     lp.m = {cam_a, cam_b, m.uv_a, m.uv_b};
     lp.keypoint_a = m.keypoint_a;
+    a.fresh.push_back(m.uv_a);
+    b.fresh.push_back(m.uv_b);
     lp.outlier = vision::label_pixel_pair(m.uv_a, a.model, a.true_pose, a.frame.depth, m.uv_b,
                                           b.model, b.true_pose, b.frame.depth)
                      .label != vision::Label::Inlier;
@@ -242,6 +256,7 @@ std::vector<LabelledCorrespondence> RenderedFrontend::new_points(int cam, int ne
     LabelledCorrespondence lc;
     lc.c = {cam, -1, m.uv_a};
     lc.keypoint = m.keypoint_a;
+    c.fresh.push_back(m.uv_a);
     out.push_back(lc);
   }
   return out;
@@ -255,6 +270,44 @@ std::optional<Eigen::Vector3d> RenderedFrontend::added(slam::LandmarkId id, int 
   auto truth = vision::back_project(uv, c.model, c.true_pose, c.frame.depth);
   truth_[id] = truth;
   return truth;
+}
+
+void RenderedFrontend::open_video(const std::string& path) {
+  video_path_ = path;
+  int w = 0, h = 0;
+  for (const auto& c : cams_) {
+    w += c.model.width() / 2;
+    h = std::max(h, c.model.height() / 2);
+  }
+  video_ = std::make_unique<cv::VideoWriter>(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                                             scn_.rate, cv::Size(w, h));
+  if (!video_->isOpened())
+    throw std::invalid_argument(path + ": cannot write a video there (MJPG in AVI)");
+}
+
+void RenderedFrontend::write_video_frame(double t) {
+  if (!video_) return;
+  std::vector<cv::Mat> tiles;
+  int h = 0;
+  for (const auto& c : cams_) h = std::max(h, c.model.height() / 2);
+  for (std::size_t j = 0; j < cams_.size(); ++j) {
+    const Cam& c = cams_[j];
+    cv::Mat bgr;
+    cv::cvtColor(c.frame.rgb, bgr, cv::COLOR_RGB2BGR);
+    cv::resize(bgr, bgr, cv::Size(c.model.width() / 2, c.model.height() / 2), 0, 0, cv::INTER_AREA);
+    auto pt = [](const Eigen::Vector2d& uv) { return cv::Point2d(uv.x() / 2, uv.y() / 2); };
+    for (const auto& uv : c.tracked) cv::circle(bgr, pt(uv), 4, {0, 0, 255}, 1, cv::LINE_AA);
+    for (const auto& uv : c.accepted) cv::circle(bgr, pt(uv), 4, {0, 200, 0}, 2, cv::LINE_AA);
+    for (const auto& uv : c.fresh) cv::drawMarker(bgr, pt(uv), {0, 230, 255}, cv::MARKER_CROSS, 9, 2);
+    if (c.lead) cv::circle(bgr, pt(*c.lead), 12, {255, 0, 255}, 2, cv::LINE_AA);
+    cv::putText(bgr, fmt_label(scn_.uavs[cam_uav_[j]].name, t), {8, 22}, cv::FONT_HERSHEY_SIMPLEX,
+                0.6, {255, 255, 255}, 2, cv::LINE_AA);
+    if (bgr.rows < h) cv::copyMakeBorder(bgr, bgr, 0, h - bgr.rows, 0, 0, cv::BORDER_CONSTANT);
+    tiles.push_back(bgr);
+  }
+  cv::Mat out;
+  cv::hconcat(tiles, out);
+  video_->write(out);
 }
 
 void RenderedFrontend::removed(slam::LandmarkId id) {

@@ -15,6 +15,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <opencv2/videoio.hpp>
+
 #include "eval/run_record.hpp"
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
@@ -93,6 +95,12 @@ class RenderedFrontend {
                                        const Eigen::Vector2d& uv, std::int64_t frame);
   void removed(slam::LandmarkId id);
 
+  // --video: every camera side by side (half size) per step, with tracked landmarks (green when
+  // the filter accepted them, red when it rejected them), new landmarks' pixels (yellow) and the
+  // lead detection (magenta). Throws std::invalid_argument naming the file if it cannot be opened.
+  void open_video(const std::string& path);
+  void write_video_frame(double t);
+
  private:
   struct Cam {
     geometry::PinholeCamera model;
@@ -102,6 +110,7 @@ class RenderedFrontend {
     std::vector<vision::LandmarkPrediction> preds;  // this step's, for free features and spread
     std::vector<bool> used;                         // keypoints taken by tracking
     std::optional<Eigen::Vector2d> lead;
+    std::vector<Eigen::Vector2d> tracked, accepted, fresh;  // this step's, for the video
   };
   const sim::Scenario& scn_;
   std::vector<int> cam_uav_;
@@ -118,6 +127,8 @@ class RenderedFrontend {
   std::vector<Cam> cams_;
   Eigen::Vector3d lead_truth_ = Eigen::Vector3d::Zero();  // this step's, for the tallies only
   bool colour_lead_ = false;
+  std::unique_ptr<cv::VideoWriter> video_;
+  std::string video_path_;
 };
 
 }  // namespace wingman::app

@@ -42,8 +42,17 @@ TEST(RenderedPipeline, SmokeRunMeetsIssueSixTargets) {
   std::string why;
   if (!gl_available(&why)) GTEST_SKIP() << why;
   const sim::Scenario scn = variant("multi");
-  const eval::RunRecord rec = run_scenario(scn, render::GlBackend::Auto);
+  TempDir dir;
+  const fs::path video = dir / "run.avi";
+  const eval::RunRecord rec = run_scenario(scn, RenderedOptions(render::GlBackend::Auto, video.string()));
   const eval::Metrics m = eval::compute_metrics(rec);
+
+  {
+    SCOPED_TRACE("--video wrote an AVI");
+    ASSERT_TRUE(fs::exists(video));
+    EXPECT_EQ(read_file(video).substr(8, 4), "AVI ");
+    EXPECT_GT(fs::file_size(video), 100000u);
+  }
 
   {
     SCOPED_TRACE("the run completes on rendered frames");
