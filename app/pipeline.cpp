@@ -203,9 +203,13 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     const double t_predict = ms_since(t0);
     double t_render = 0, t_detect = 0, t_match = 0;
     if (fe) {
-      t_render = fe->render(truth, k, t);
       for (int j = 0; j < ncam; ++j) est.set_camera_rotation(j, truth.commanded_R_CW());
-      t_detect = fe->detect(est, rec.frontend);
+      const StageTimes st = fe->render_and_detect(truth, k, t, est, rec.frontend);
+      // Stage times add up to the step's wall time: detection is what it added beyond rendering
+      // (it overlaps the next camera's render); its full duration is kept in the frontend record.
+      t_render = st.render_ms;
+      t_detect = std::max(0.0, st.wall_ms - st.render_ms);
+      rec.frontend.detect_busy_ms += st.detect_ms;
     }
 
     // Landmark correspondences for what the filter predicts in view, by identity.

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -102,13 +103,20 @@ std::string RenderedFrontend::renderer_description() const {
   return ctx_ ? ctx_->description() : std::string("dataset replay");
 }
 
-double RenderedFrontend::render(const sim::Truth& truth, int k, double t) {
-  const auto t0 = Clock::now();
+StageTimes RenderedFrontend::render_and_detect(const sim::Truth& truth, int k, double t,
+                                               const slam::Estimator& est,
+                                               eval::FrontendRecord& fr) {
+  StageTimes st;
+  const auto t_start = Clock::now();
   render::LeadPose lead = render::lead_pose(scn_, t);
   lead.position = truth.lead(t).position;
   const Eigen::Matrix3d R_CW = truth.camera_R_CW(t);
+  // Camera j's detection runs on a second thread while camera j+1 renders (the GL context stays
+  // on this thread; two detections never run at once, so the extractor is never shared).
+  std::future<double> pending;
   for (std::size_t j = 0; j < cams_.size(); ++j) {
     Cam& c = cams_[j];
+    const auto t0 = Clock::now();
     c.true_pose = {R_CW, truth.camera(cam_uav_[j], t).position};
     if (frames_) {
       c.frame = frames_(static_cast<int>(j), k);
@@ -116,47 +124,18 @@ double RenderedFrontend::render(const sim::Truth& truth, int k, double t) {
       c.frame = renderer_->render({c.model, R_CW, c.true_pose.position}, lead);
       effects_[j]->apply(c.frame);
     }
+    st.render_ms += ms_since(t0);
+    if (pending.valid()) st.detect_ms += pending.get();
+    pending = std::async(std::launch::async, [this, j, &est] { return detect_camera(static_cast<int>(j), est); });
   }
-  // The lead's truth is kept for the detector's tallies in detect().
-  lead_truth_ = lead.position;
-  return ms_since(t0);
-}
+  if (pending.valid()) st.detect_ms += pending.get();
+  st.wall_ms = ms_since(t_start);
 
-double RenderedFrontend::detect(const slam::Estimator& est, eval::FrontendRecord& fr) {
-  double ms = 0;
-  for (std::size_t j = 0; j < cams_.size(); ++j) {
-    Cam& c = cams_[j];
-    // Where the estimate puts the lead in this image (estimated camera, commanded orientation).
-    const auto& rig = est.camera(static_cast<int>(j));
-    const Eigen::Vector3d p_est = rig.R_CW * (est.lead_position() - est.camera_position(static_cast<int>(j)));
-    std::optional<Eigen::Vector2d> predicted = c.model.project(p_est);
-    if (predicted && !c.model.in_image(*predicted, -100)) predicted.reset();
-
-    const auto t0 = Clock::now();
-    const cv::Mat grey = c.frame.gray();
-    cv::Mat bgr;
-    if (colour_lead_) cv::cvtColor(c.frame.rgb, bgr, cv::COLOR_RGB2BGR);
-    const auto det = lead_.detect(colour_lead_ ? bgr : grey, predicted);
-    c.lead.reset();
-    std::vector<vision::ExclusionBox> exclude;
-    if (det) {
-      c.lead = det->uv;
-      exclude.push_back(vision::exclusion_box(*det));
-    } else if (predicted) {
-      exclude.push_back(predicted_lead_box(*predicted, c.model.fx(), p_est.z(), scn_));
-    }
-    c.features = features_.detect(grey, exclude);
-    ms += ms_since(t0);
-    c.tracked.clear();
-    c.accepted.clear();
-    c.fresh.clear();
-    c.preds.clear();  // a camera whose landmarks are switched off tracks nothing this step
-    c.used.assign(c.features.size(), false);
-
-    // Tallies against the truth (evaluation only): in view when the reference point projects
-    // inside the image with room for the marker and the rendered depth there is the lead's.
+  // Tallies against the truth (evaluation only): in view when the reference point projects
+  // inside the image with room for the marker and the rendered depth there is the lead's.
+  for (auto& c : cams_) {
     ++fr.frames;
-    const Eigen::Vector3d p_true = c.true_pose.to_camera(lead_truth_);
+    const Eigen::Vector3d p_true = c.true_pose.to_camera(lead.position);
     const auto uv_true = c.model.project(p_true);
     bool in_view = false;
     if (uv_true && c.model.in_image(*uv_true, 15)) {
@@ -164,8 +143,8 @@ double RenderedFrontend::detect(const slam::Estimator& est, eval::FrontendRecord
       in_view = d && std::abs(*d - p_true.z()) < 0.3;
     }
     if (in_view) ++fr.lead_in_view;
-    if (det) {
-      const double err = in_view ? (det->uv - *uv_true).norm() : INFINITY;
+    if (c.lead) {
+      const double err = in_view ? (*c.lead - *uv_true).norm() : INFINITY;
       if (err <= fr.lead_match_px) {
         ++fr.lead_detected;
         fr.lead_error_px.push_back(err);
@@ -174,6 +153,36 @@ double RenderedFrontend::detect(const slam::Estimator& est, eval::FrontendRecord
       }
     }
   }
+  return st;
+}
+
+double RenderedFrontend::detect_camera(int j, const slam::Estimator& est) {
+  Cam& c = cams_[j];
+  // Where the estimate puts the lead in this image (estimated camera, commanded orientation).
+  const Eigen::Vector3d p_est = est.camera(j).R_CW * (est.lead_position() - est.camera_position(j));
+  std::optional<Eigen::Vector2d> predicted = c.model.project(p_est);
+  if (predicted && !c.model.in_image(*predicted, -100)) predicted.reset();
+
+  const auto t0 = Clock::now();
+  const cv::Mat grey = c.frame.gray();
+  cv::Mat bgr;
+  if (colour_lead_) cv::cvtColor(c.frame.rgb, bgr, cv::COLOR_RGB2BGR);
+  const auto det = lead_.detect(colour_lead_ ? bgr : grey, predicted);
+  c.lead.reset();
+  std::vector<vision::ExclusionBox> exclude;
+  if (det) {
+    c.lead = det->uv;
+    exclude.push_back(vision::exclusion_box(*det));
+  } else if (predicted) {
+    exclude.push_back(predicted_lead_box(*predicted, c.model.fx(), p_est.z(), scn_));
+  }
+  c.features = features_.detect(grey, exclude);
+  const double ms = ms_since(t0);
+  c.tracked.clear();
+  c.accepted.clear();
+  c.fresh.clear();
+  c.preds.clear();  // a camera whose landmarks are switched off tracks nothing this step
+  c.used.assign(c.features.size(), false);
   return ms;
 }
 

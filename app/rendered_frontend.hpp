@@ -36,6 +36,12 @@ class ImageEffects;
 
 namespace wingman::app {
 
+struct StageTimes {
+  double render_ms = 0;  // rendering (or loading) summed over the cameras
+  double detect_ms = 0;  // detection summed over the cameras, part of it during rendering
+  double wall_ms = 0;    // the whole of render_and_detect
+};
+
 // A landmark correspondence proposed by tracking, with its ground-truth label.
 struct LabelledCorrespondence {
   slam::Correspondence c;
@@ -68,12 +74,12 @@ class RenderedFrontend {
   std::string renderer_description() const;
   std::string detector_name() const { return vision::to_string(features_.settings().kind); }
 
-  // Renders (or loads) every camera's frame of step k at t (true pose, gimbal error included);
-  // returns ms spent.
-  double render(const sim::Truth& truth, int k, double t);
-  // Lead detection (searched first around the estimate's projection) and features outside the
-  // lead's box, for every camera; updates the lead detector's tallies in `fr`. Returns ms spent.
-  double detect(const slam::Estimator& est, eval::FrontendRecord& fr);
+  // Renders (or loads) every camera's frame of step k at t (true pose, gimbal error included),
+  // then per camera the lead detection (searched first around the estimate's projection) and
+  // features outside the lead's box; updates the lead detector's tallies in `fr`. Camera j's
+  // detection overlaps camera j+1's rendering, so the two times may add up to more than the wall.
+  StageTimes render_and_detect(const sim::Truth& truth, int k, double t, const slam::Estimator& est,
+                               eval::FrontendRecord& fr);
   std::optional<Eigen::Vector2d> lead_pixel(int cam) const { return cams_[cam].lead; }
 
   // Tracking of the filter's predictions in camera `cam`, labelled against the truth.
@@ -102,6 +108,7 @@ class RenderedFrontend {
   void write_video_frame(double t);
 
  private:
+  double detect_camera(int cam, const slam::Estimator& est);  // ms spent
   struct Cam {
     geometry::PinholeCamera model;
     render::Frame frame;
@@ -125,7 +132,6 @@ class RenderedFrontend {
   vision::DescriptorStore store_;
   std::unordered_map<slam::LandmarkId, std::optional<Eigen::Vector3d>> truth_;
   std::vector<Cam> cams_;
-  Eigen::Vector3d lead_truth_ = Eigen::Vector3d::Zero();  // this step's, for the tallies only
   bool colour_lead_ = false;
   std::unique_ptr<cv::VideoWriter> video_;
   std::string video_path_;

@@ -183,6 +183,8 @@ Metrics compute_metrics(const RunRecord& run) {
     if (f.lead_in_view > 0)
       m.frontend.lead_detection_rate = static_cast<double>(f.lead_detected) / f.lead_in_view;
     m.frontend.lead_error_px = summarise(f.lead_error_px);
+    if (run.steps.size() > 1)
+      m.frontend.detect_busy_ms_per_step = f.detect_busy_ms / static_cast<double>(run.steps.size() - 1);
   }
   m.landmarks.initialised = static_cast<long>(run.landmarks.size());
   m.formation = compute_formation_metrics(run);

@@ -69,6 +69,7 @@ struct FrontendMetrics {
   double lead_detection_rate = kNaN;  // lead_detected / lead_in_view
   Stats lead_error_px;
   long lead_in_view = 0, lead_detected = 0, lead_false = 0, frames = 0;
+  double detect_busy_ms_per_step = kNaN;  // detection's whole duration (timings_ms.detect: exposed part)
 };
 
 struct LandmarkCounts {

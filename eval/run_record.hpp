@@ -89,6 +89,7 @@ struct FrontendRecord {
   long lead_detected = 0; // of those, frames with a detection within lead_match_px of the truth
   long lead_false = 0;    // detections farther than lead_match_px, or with the lead out of view
   double lead_match_px = 10;
+  double detect_busy_ms = 0;  // detection's whole duration over the run (partly behind rendering)
   std::vector<double> lead_error_px;  // detection to true projection, for the lead_detected frames
 };
 

@@ -139,7 +139,8 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
                      {"lead_false_detections", f.lead_false},
                      {"lead_match_px", num(run.frontend.lead_match_px)},
                      {"lead_detection_rate", num(f.lead_detection_rate)},
-                     {"lead_error_px", stats(f.lead_error_px)}};
+                     {"lead_error_px", stats(f.lead_error_px)},
+                     {"detect_busy_ms_per_step", num(f.detect_busy_ms_per_step)}};
   }
   j["landmarks"] = {{"initialised", m.landmarks.initialised},
                     {"max_in_state", m.landmarks.max_in_state},
@@ -381,8 +382,11 @@ std::string format_summary(const Metrics& m, const RunRecord& run) {
                  cell(t.init.mean, 0, 3), cell(t.total.median, 0, 3), cell(t.total.p95, 0, 3),
                  cell(t.total.max, 0, 3));
   if (m.frontend.present) {
-    fmt::format_to(out, "Stages [ms/step, mean]: render {}, detect {}, match {}, EKF {}, init {}\n",
-                   cell(t.render.mean, 0, 3), cell(t.detect.mean, 0, 3), cell(t.match.mean, 0, 3),
+    fmt::format_to(out,
+                   "Stages [ms/step, mean]: render {}, detect {} (busy {}, partly behind rendering), "
+                   "match {}, EKF {}, init {}\n",
+                   cell(t.render.mean, 0, 3), cell(t.detect.mean, 0, 3),
+                   cell(m.frontend.detect_busy_ms_per_step, 0, 3), cell(t.match.mean, 0, 3),
                    cell(t.predict.mean + t.update.mean, 0, 3), cell(t.init.mean, 0, 3));
     const FrontendMetrics& f = m.frontend;
     fmt::format_to(out, "Lead detector: {} of {} frames in view ({}), error median {} px, p95 {} px, "
