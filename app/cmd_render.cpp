@@ -117,6 +117,7 @@ int render_command(const RenderOptions& o) {
   }
   const sim::Scenario scn = pick(o);
   const int n = steps_to_render(o, scn);
+  InterruptGuard guard;  // from here on Ctrl-C is noticed at the next step and cleans up
   const fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);
 
   render::Scene scene;
@@ -163,7 +164,6 @@ int render_command(const RenderOptions& o) {
     effects.emplace_back(scn.world.image, scn.seed, u.name);
   }
 
-  InterruptGuard guard;
   const int cams = static_cast<int>(scn.uavs.size());
   ProgressLine progress(fmt::format("[render {}]", scn.name), o.quiet);
   const auto start = std::chrono::steady_clock::now();
