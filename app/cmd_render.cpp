@@ -177,7 +177,9 @@ int render_command(const RenderOptions& o) {
     const std::int64_t t_ns = datasets::step_ns(k, scn.rate);
     const render::LeadPose lead = render::lead_pose(scn, t);
     const sim::KinematicState lk = truth.lead(t);
-    writer.ground_truth("lead", pose(t_ns, lk.position, geometry::rot_z(lead.yaw), lk.velocity));
+    // Ground truth heading: the path's, without the model's yaw_offset.
+    const double heading = lead.yaw - scn.world.lead.yaw_offset;
+    writer.ground_truth("lead", pose(t_ns, lk.position, geometry::rot_z(heading), lk.velocity));
     if (scn.lead.gps) writer.gps("lead", {t_ns, sensors.gps(t)});
     const Eigen::Matrix3d R_CW = truth.camera_R_CW(t);
     for (int j = 0; j < cams; ++j) {
