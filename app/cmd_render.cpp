@@ -117,6 +117,7 @@ int render_command(const RenderOptions& o) {
   }
   const sim::Scenario scn = pick(o);
   const int n = steps_to_render(o, scn);
+  InterruptGuard guard;  // from here on Ctrl-C is noticed at the next step and cleans up
   const fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);
 
   render::Scene scene;
@@ -163,7 +164,6 @@ int render_command(const RenderOptions& o) {
     effects.emplace_back(scn.world.image, scn.seed, u.name);
   }
 
-  InterruptGuard guard;
   const int cams = static_cast<int>(scn.uavs.size());
   ProgressLine progress(fmt::format("[render {}]", scn.name), o.quiet);
   const auto start = std::chrono::steady_clock::now();
@@ -177,7 +177,9 @@ int render_command(const RenderOptions& o) {
     const std::int64_t t_ns = datasets::step_ns(k, scn.rate);
     const render::LeadPose lead = render::lead_pose(scn, t);
     const sim::KinematicState lk = truth.lead(t);
-    writer.ground_truth("lead", pose(t_ns, lk.position, geometry::rot_z(lead.yaw), lk.velocity));
+    // Ground truth heading: the path's, without the model's yaw_offset.
+    const double heading = lead.yaw - scn.world.lead.yaw_offset;
+    writer.ground_truth("lead", pose(t_ns, lk.position, geometry::rot_z(heading), lk.velocity));
     if (scn.lead.gps) writer.gps("lead", {t_ns, sensors.gps(t)});
     const Eigen::Matrix3d R_CW = truth.camera_R_CW(t);
     for (int j = 0; j < cams; ++j) {

@@ -97,11 +97,16 @@ struct Dataset {
 // Time stamp of step k at a rate, in integer nanoseconds.
 std::int64_t step_ns(int k, double rate);
 
+// PNG encoding runs on background threads (it costs more than a GPU frame), at most a few frames
+// queued per thread; an encoding error is rethrown by the next write_frame() or by finish().
 class DatasetWriter {
  public:
-  // `dir` must exist and be empty (the caller's staging directory).
-  DatasetWriter(std::filesystem::path dir, DatasetInfo info);
+  // `dir` must exist and be empty (the caller's staging directory). `threads` 0: one per core,
+  // at most 8.
+  DatasetWriter(std::filesystem::path dir, DatasetInfo info, unsigned threads = 0);
   ~DatasetWriter();
+  DatasetWriter(const DatasetWriter&) = delete;
+  DatasetWriter& operator=(const DatasetWriter&) = delete;
   // An agent, with a camera for a UAV. Creates its folders.
   void add_agent(const std::string& name, const std::optional<CameraInfo>& camera);
   // One frame: colour (RGB, CV_8UC3; written as gray when the camera has 1 channel) and depth in
@@ -114,14 +119,16 @@ class DatasetWriter {
   void altimeter(const std::string& agent, const ScalarSample& s);
   void range(const std::string& agent, const ScalarSample& s);
   void ahrs(const std::string& agent, const ScalarSample& s);
-  // Writes the CSVs, the sensor.yaml files and, last, dataset.yaml.
+  // Waits for the images, then writes the CSVs, the sensor.yaml files and, last, dataset.yaml.
   void finish();
 
  private:
+  struct Encoder;
   AgentData& get(const std::string& agent);
   std::filesystem::path dir_;
   DatasetInfo info_;
   std::vector<AgentData> agents_;
+  std::unique_ptr<Encoder> encoder_;
 };
 
 // Loads and validates a dataset directory: dataset.yaml with a known format version, every

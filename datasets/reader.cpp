@@ -249,6 +249,9 @@ Dataset read_dataset(const fs::path& dir) {
         fail(ad / "cam0" / "data.csv", fmt::format("lists {} frames, dataset.yaml says {}",
                                                    a.frames.size(), ds.info.frames));
       a.camera_pose = read_poses(ad / "groundtruth" / "cam0.csv", false);
+      if (a.camera_pose.size() != a.frames.size())
+        fail(ad / "groundtruth" / "cam0.csv",
+             fmt::format("has {} poses for {} frames", a.camera_pose.size(), a.frames.size()));
     }
     if (fs::exists(ad / "gps0", ec)) {
       const fs::path csv = ad / "gps0" / "data.csv";

@@ -4,6 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -17,7 +23,78 @@ std::int64_t step_ns(int k, double rate) {
   return static_cast<std::int64_t>(std::llround(static_cast<double>(k) * 1e9 / rate));
 }
 
-DatasetWriter::DatasetWriter(fs::path dir, DatasetInfo info) : dir_(std::move(dir)), info_(std::move(info)) {}
+// A bounded queue of encoding jobs served by worker threads.
+struct DatasetWriter::Encoder {
+  explicit Encoder(unsigned threads) : limit(4 * threads) {
+    for (unsigned i = 0; i < threads; ++i) workers.emplace_back([this] { serve(); });
+  }
+  ~Encoder() {
+    {
+      std::lock_guard lock(m);
+      stop = true;
+    }
+    cv_jobs.notify_all();
+    for (auto& w : workers) w.join();
+  }
+  void push(std::function<void()> job) {
+    std::unique_lock lock(m);
+    cv_room.wait(lock, [&] { return jobs.size() < limit || error; });
+    rethrow_locked();
+    jobs.push_back(std::move(job));
+    cv_jobs.notify_one();
+  }
+  // Waits until every queued job is done; rethrows the first error.
+  void drain() {
+    std::unique_lock lock(m);
+    cv_room.wait(lock, [&] { return (jobs.empty() && busy == 0) || error; });
+    rethrow_locked();
+  }
+
+ private:
+  void rethrow_locked() {
+    if (error) std::rethrow_exception(error);
+  }
+  void serve() {
+    for (;;) {
+      std::function<void()> job;
+      {
+        std::unique_lock lock(m);
+        cv_jobs.wait(lock, [&] { return stop || !jobs.empty(); });
+        if (jobs.empty()) return;
+        job = std::move(jobs.front());
+        jobs.pop_front();
+        ++busy;
+      }
+      std::exception_ptr e;
+      try {
+        job();
+      } catch (...) {
+        e = std::current_exception();
+      }
+      {
+        std::lock_guard lock(m);
+        --busy;
+        if (e && !error) error = e;
+      }
+      cv_room.notify_all();
+    }
+  }
+
+  std::size_t limit;
+  std::mutex m;
+  std::condition_variable cv_jobs, cv_room;
+  std::deque<std::function<void()>> jobs;
+  std::vector<std::thread> workers;
+  std::size_t busy = 0;
+  bool stop = false;
+  std::exception_ptr error;
+};
+
+DatasetWriter::DatasetWriter(fs::path dir, DatasetInfo info, unsigned threads)
+    : dir_(std::move(dir)), info_(std::move(info)) {
+  if (threads == 0) threads = std::clamp(std::thread::hardware_concurrency(), 1u, 8u);
+  encoder_ = std::make_unique<Encoder>(threads);
+}
 DatasetWriter::~DatasetWriter() = default;
 
 AgentData& DatasetWriter::get(const std::string& agent) {
@@ -74,19 +151,22 @@ void DatasetWriter::write_frame(const std::string& agent, std::int64_t t_ns, con
   AgentData& a = get(agent);
   if (!a.camera) throw std::logic_error("dataset writer: agent '" + agent + "' has no camera");
   const std::string file = fmt::format("{}.png", t_ns);
+  const bool gray = a.camera->channels == 1;
+  const fs::path colour_path = dir_ / agent / "cam0" / "data" / file;
+  const fs::path depth_path = dir_ / agent / "depth0" / "data" / file;
+  // Converted here (cheap), encoded on a worker (costly); the job owns its images.
   cv::Mat out;
-  if (a.camera->channels == 1)
-    cv::cvtColor(rgb, out, cv::COLOR_RGB2GRAY);
-  else
-    cv::cvtColor(rgb, out, cv::COLOR_RGB2BGR);
-  write_png(dir_ / agent / "cam0" / "data" / file, out);
+  cv::cvtColor(rgb, out, gray ? cv::COLOR_RGB2GRAY : cv::COLOR_RGB2BGR);
   cv::Mat mm;
   // Metres to millimetres; 0 (no surface) stays 0 and anything beyond 65.535 m becomes 0 too
   // rather than a wrong, saturated distance.
   cv::Mat valid = (depth > 0) & (depth < 65.5355);
   depth.convertTo(mm, CV_16U, 1.0 / kDepthScale);
   mm.setTo(0, ~valid);
-  write_png(dir_ / agent / "depth0" / "data" / file, mm);
+  encoder_->push([out, mm, colour_path, depth_path] {
+    write_png(colour_path, out);
+    write_png(depth_path, mm);
+  });
   a.frames.push_back(t_ns);
 }
 
@@ -98,6 +178,7 @@ void DatasetWriter::range(const std::string& agent, const ScalarSample& s) { get
 void DatasetWriter::ahrs(const std::string& agent, const ScalarSample& s) { get(agent).ahrs.push_back(s); }
 
 void DatasetWriter::finish() {
+  encoder_->drain();
   const auto g = [](double x) { return fmt::format("{:.9g}", x + 0.0); };  // no "-0"
   for (const AgentData& a : agents_) {
     const fs::path d = dir_ / a.name;

@@ -8,6 +8,8 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace wingman::render {
 
@@ -36,6 +38,12 @@ class GlContext {
 // An OpenGL >= 3.3 core context. Auto tries EGL (device platform, then surfaceless), then OSMesa.
 // Env WINGMAN_EGL_DEVICE=<index> picks an EGL device.
 std::unique_ptr<GlContext> create_gl_context(GlBackend backend);
+
+// The first context one of these factories makes, in order; when all fail, a GlContextError
+// lists each by name with its reason (what create_gl_context(Auto) does with EGL and OSMesa).
+using GlContextFactory = std::unique_ptr<GlContext> (*)();
+std::unique_ptr<GlContext> create_first_gl_context(
+    const std::vector<std::pair<std::string, GlContextFactory>>& factories);
 
 // One backend only; throws GlContextError naming what failed.
 std::unique_ptr<GlContext> create_egl_context();

@@ -183,5 +183,27 @@ TEST(Dataset, CorruptCsvRowNamesTheFileAndLine) {
   EXPECT_NE(e.find("'abc' is not a number"), std::string::npos) << e;
 }
 
+TEST(Dataset, AnImageThatCannotBeWrittenFailsTheWriterNamingIt) {
+  TempDir tmp;
+  DatasetInfo info;
+  info.agents = {"uav1"};
+  DatasetWriter w(tmp.path, info, 2);
+  CameraInfo cam;
+  cam.camera = geometry::PinholeCamera(40, 40, 31.5, 23.5, 64, 48);
+  w.add_agent("uav1", cam);
+  fs::remove_all(tmp.path / "uav1" / "cam0" / "data");  // the encoder cannot write there
+  try {
+    for (int k = 0; k < 50; ++k)
+      w.write_frame("uav1", step_ns(k, 10), cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(9)),
+                    cv::Mat(48, 64, CV_32F, cv::Scalar(3)));
+    w.finish();
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot write"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cam0/data"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(tmp.path / "dataset.yaml"));
+}
+
 }  // namespace
 }  // namespace wingman::datasets

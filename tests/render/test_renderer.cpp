@@ -133,5 +133,19 @@ TEST(GlContext, BackendNamesRoundTrip) {
   EXPECT_THROW(gl_backend_from_string("vulkan"), std::invalid_argument);
 }
 
+std::unique_ptr<GlContext> no_library() { throw GlContextError("cannot load libfoo.so.1"); }
+std::unique_ptr<GlContext> no_device() { throw GlContextError("no devices"); }
+
+TEST(GlContext, WhenNothingWorksTheErrorListsWhatWasTriedAndWhy) {
+  try {
+    create_first_gl_context({{"egl", no_device}, {"osmesa", no_library}});
+    FAIL() << "no error";
+  } catch (const GlContextError& e) {
+    EXPECT_STREQ(e.what(),
+                 "no OpenGL context could be created; tried:\n  egl: no devices\n  osmesa: "
+                 "cannot load libfoo.so.1");
+  }
+}
+
 }  // namespace
 }  // namespace wingman::render
