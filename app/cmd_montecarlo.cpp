@@ -26,6 +26,7 @@
 
 #include "app/progress.hpp"
 #include "app/subcommand.hpp"
+#include "app/variants.hpp"
 #include "eval/montecarlo.hpp"
 #include "eval/plots.hpp"
 #include "eval/results_dir.hpp"
@@ -105,18 +106,8 @@ std::vector<std::pair<std::string, std::string>> variant_labels(const std::vecto
 
 int montecarlo_command(const MonteCarloOptions& o) {
   if (o.runs < 1) throw UsageError("--runs must be at least 1");
-  auto scenarios = sim::load_scenarios(o.scenario);  // bad input fails here, before any work
-  if (!o.variants.empty()) {
-    std::vector<sim::Scenario> keep;
-    for (const auto& name : o.variants) {
-      auto it = std::find_if(scenarios.begin(), scenarios.end(),
-                             [&](const sim::Scenario& s) { return s.variant == name; });
-      if (it == scenarios.end())
-        throw UsageError(fmt::format("{}: no variant '{}'", o.scenario, name));
-      keep.push_back(*it);
-    }
-    scenarios = keep;
-  }
+  // Bad input fails here, before any work.
+  const auto scenarios = select_variants(sim::load_scenarios(o.scenario), o.variants, o.scenario);
   if (!o.no_plots && !eval::gnuplot_available())
     throw UsageError("gnuplot with the pngcairo terminal was not found; install it (setup.sh does) "
                      "or pass --no-plots");

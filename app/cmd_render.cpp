@@ -3,6 +3,7 @@
 // is staged next to --out and renamed into place only when complete, so a failed or interrupted
 // run (Ctrl-C included) never leaves a directory that looks finished.
 #include "app/subcommand.hpp"
+#include "app/variants.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -70,19 +71,7 @@ struct RenderOptions {
 };
 
 sim::Scenario pick(const RenderOptions& o) {
-  auto scenarios = sim::load_scenarios(o.scenario);
-  sim::Scenario scn = scenarios.front();
-  if (!o.variant.empty()) {
-    auto it = std::find_if(scenarios.begin(), scenarios.end(),
-                           [&](const sim::Scenario& s) { return s.variant == o.variant; });
-    if (it == scenarios.end()) {
-      std::string known;
-      for (const auto& s : scenarios) known += (known.empty() ? "" : ", ") + s.variant;
-      throw UsageError(fmt::format("{}: no variant '{}' (variants: {})", o.scenario, o.variant,
-                                   known.empty() ? "none" : known));
-    }
-    scn = *it;
-  }
+  sim::Scenario scn = select_variant(sim::load_scenarios(o.scenario), o.variant, o.scenario);
   if (o.seed) scn.seed = *o.seed;
   return scn;
 }

@@ -1,5 +1,6 @@
 // `wingman run`: every variant of a scenario end to end into one results directory.
 #include "app/subcommand.hpp"
+#include "app/variants.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -43,22 +44,7 @@ int run_command(const RunOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  auto scenarios = sim::load_scenarios(o.scenario);
-  if (!o.variants.empty()) {
-    std::vector<sim::Scenario> keep;
-    for (const auto& name : o.variants) {
-      auto it = std::find_if(scenarios.begin(), scenarios.end(),
-                             [&](const sim::Scenario& s) { return s.variant == name; });
-      if (it == scenarios.end()) {
-        std::string known;
-        for (const auto& s : scenarios) known += (known.empty() ? "" : ", ") + s.variant;
-        throw UsageError(fmt::format("{}: no variant '{}' (variants: {})", o.scenario, name,
-                                     known.empty() ? "none" : known));
-      }
-      keep.push_back(*it);
-    }
-    scenarios = std::move(keep);
-  }
+  auto scenarios = select_variants(sim::load_scenarios(o.scenario), o.variants, o.scenario);
   if (o.seed)
     for (auto& s : scenarios) s.seed = *o.seed;
   if (!o.no_plots && !eval::gnuplot_available())

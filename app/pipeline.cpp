@@ -303,15 +303,12 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     t0 = Clock::now();
     int initialised = 0;
     double t_cross = 0;
-    // Rendered mode: the landmark's truth is the back-projection of its first observation.
-    auto add_rendered = [&](slam::LandmarkId id, int cam, int keypoint, const Eigen::Vector2d& uv,
-                            const char* origin) {
-      ++initialised;
-      const auto truth_point = fe->added(id, cam, keypoint, uv, k);
-      if (!truth_point) return;  // no rendered surface there: left out of Table 5
+    // A new landmark's record for Table 5, with its truth.
+    auto record_landmark = [&](slam::LandmarkId id, const Eigen::Vector3d& truth_point,
+                               const char* origin) {
       eval::LandmarkRecord lr;
       lr.id = id;
-      lr.truth = *truth_point;
+      lr.truth = truth_point;
       lr.t_init = t;
       lr.init_phase = phase;
       lr.est_init = lr.est_phase_end = lr.est_final = *est.landmark_position(id);
@@ -319,17 +316,17 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
       lm_record[id] = rec.landmarks.size();
       rec.landmarks.push_back(lr);
     };
+    // Rendered mode: the landmark's truth is the back-projection of its first observation.
+    auto add_rendered = [&](slam::LandmarkId id, int cam, int keypoint, const Eigen::Vector2d& uv,
+                            const char* origin) {
+      ++initialised;
+      const auto truth_point = fe->added(id, cam, keypoint, uv, k);
+      if (!truth_point) return;  // no rendered surface there: left out of Table 5
+      record_landmark(id, *truth_point, origin);
+    };
     auto add_record = [&](slam::LandmarkId id, std::size_t point, const char* origin) {
       source.bind(id, point);
-      eval::LandmarkRecord lr;
-      lr.id = id;
-      lr.truth = source.field()[point];
-      lr.t_init = t;
-      lr.init_phase = phase;
-      lr.est_init = lr.est_phase_end = lr.est_final = *est.landmark_position(id);
-      lr.origin = origin;
-      lm_record[id] = rec.landmarks.size();
-      rec.landmarks.push_back(lr);
+      record_landmark(id, source.field()[point], origin);
       ++initialised;
     };
     if (single) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "app/subcommand.hpp"
+#include "app/variants.hpp"
 
 namespace wingman::app {
 
@@ -20,14 +21,7 @@ Replay load_replay(const std::string& dir, const std::string& variant) {
     throw UsageError(r.scenario_path.string() + ": missing (wingman render writes it)");
   auto scenarios = sim::load_scenarios(r.scenario_path.string());
   const std::string want = variant.empty() ? r.dataset.info.variant : variant;
-  r.scenario = scenarios.front();
-  if (!want.empty()) {
-    auto it = std::find_if(scenarios.begin(), scenarios.end(),
-                           [&](const sim::Scenario& s) { return s.variant == want; });
-    if (it == scenarios.end())
-      throw UsageError(fmt::format("{}: no variant '{}'", r.scenario_path.string(), want));
-    r.scenario = *it;
-  }
+  r.scenario = select_variant(std::move(scenarios), want, r.scenario_path.string());
   sim::Scenario& scn = r.scenario;
   scn.seed = r.dataset.info.seed;
   scn.measurements = sim::MeasurementMode::Rendered;
