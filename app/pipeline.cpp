@@ -1,4 +1,5 @@
 #include "app/pipeline.hpp"
+#include "app/timing.hpp"
 
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -23,10 +24,6 @@ namespace wingman::app {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
   const auto& e = scn.estimator;

@@ -1,4 +1,5 @@
 #include "app/rendered_frontend.hpp"
+#include "app/timing.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -16,10 +17,6 @@ namespace wingman::app {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 vision::LeadDetectorSettings lead_settings(const sim::Scenario& scn) {
   vision::LeadDetectorSettings s;

@@ -119,15 +119,22 @@ TEST(Jacobians, RangeEq9) {
 
 // The builders' block Jacobians, assembled into a dense H, against differentiation of h(x) over
 // the whole state: checks the block placement too, with and without estimated gimbal errors.
-class BuilderTest : public ::testing::TestWithParam<bool> {};
+class BuilderTest : public ::testing::TestWithParam<bool> {
+ protected:
+  // Lead and two UAVs moving along x, P = I; nonzero gimbal errors when the state holds them.
+  static FilterState two_uav_state(bool gimbal_states) {
+    FilterState s(2, gimbal_states);
+    s.x.head<18>() << 0.3, -0.2, 0.1, 1, 0, 0,  //
+        -1.4, 0.1, 15.2, 1, 0, 0,                //
+        1.6, -0.1, 16.9, 1, 0, 0;
+    if (gimbal_states) s.x.segment<4>(s.gimbal(0)) << 0.03, -0.02, -0.01, 0.04;
+    s.P.setIdentity();
+    return s;
+  }
+};
 
 TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
-  FilterState s(2, GetParam());
-  s.x.head<18>() << 0.3, -0.2, 0.1, 1, 0, 0,  //
-      -1.4, 0.1, 15.2, 1, 0, 0,                //
-      1.6, -0.1, 16.9, 1, 0, 0;
-  if (GetParam()) s.x.segment<4>(s.gimbal(0)) << 0.03, -0.02, -0.01, 0.04;
-  s.P.setIdentity();
+  FilterState s = two_uav_state(GetParam());
   const CameraRig rig = tilted_rig(true);
   s.add_landmark(LandmarkKind::Euclidean, Eigen::Vector3d(3, -2, 0.4), Eigen::MatrixXd::Zero(3, s.dim()),
                  Eigen::Matrix3d::Identity());
@@ -169,12 +176,7 @@ TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
 // state is its Jacobian with respect to the state, which must match re-initialising the landmark
 // from perturbed states (camera positions and gimbal angles alike).
 TEST_P(BuilderTest, NewLandmarkCrossCovarianceIsItsStateJacobian) {
-  FilterState s(2, GetParam());
-  s.x.head<18>() << 0.3, -0.2, 0.1, 1, 0, 0,  //
-      -1.4, 0.1, 15.2, 1, 0, 0,                //
-      1.6, -0.1, 16.9, 1, 0, 0;
-  if (GetParam()) s.x.segment<4>(s.gimbal(0)) << 0.03, -0.02, -0.01, 0.04;
-  s.P.setIdentity();
+  FilterState s = two_uav_state(GetParam());
   const CameraRig rig = tilted_rig(true);
   // Pixels of one point as the filter predicts them: rays that meet, as real matches nearly do.
   // (Least-squares triangulation of rays that miss each other weighs them algebraically, and
