@@ -64,18 +64,10 @@ RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> ca
   }
   ctx_ = render::create_gl_context(backend);
   renderer_ = std::make_unique<render::Renderer>(*ctx_, scene);
-  colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
-  // The estimator rejects pairs under its minimum parallax; filtering them before the spread
-  // selection lets it pick among pairs that can be initialised (with a 3 m baseline, most of
-  // the image's outer cells are under 8 degrees and would be chosen, and rejected, every step).
-  cross_.min_parallax_deg = scn.estimator.min_parallax_deg;
-  for (int u : cam_uav_) {
-    Cam c;
-    c.model = scn.uavs[u].camera.camera();
-    cams_.push_back(std::move(c));
+  init_cameras();
+  for (int u : cam_uav_)
     effects_.push_back(
         std::make_unique<render::ImageEffects>(scn.world.image, scn.seed, scn.uavs[u].name));
-  }
 }
 
 RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav,
@@ -85,11 +77,18 @@ RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> ca
       frames_(std::move(frames)),
       features_(features),
       lead_(lead_settings(scn)) {
+  init_cameras();
+}
+
+void RenderedFrontend::init_cameras() {
   colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
-  cross_.min_parallax_deg = scn.estimator.min_parallax_deg;
+  // The estimator rejects pairs under its minimum parallax; filtering them before the spread
+  // selection lets it pick among pairs that can be initialised (with a 3 m baseline, most of
+  // the image's outer cells are under 8 degrees and would be chosen, and rejected, every step).
+  cross_.min_parallax_deg = scn_.estimator.min_parallax_deg;
   for (int u : cam_uav_) {
     Cam c;
-    c.model = scn.uavs[u].camera.camera();
+    c.model = scn_.uavs[u].camera.camera();
     cams_.push_back(std::move(c));
   }
 }

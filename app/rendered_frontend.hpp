@@ -108,6 +108,8 @@ class RenderedFrontend {
   void write_video_frame(double t);
 
  private:
+  // What both constructors set up: the cameras' models and the frontend's settings from scn_.
+  void init_cameras();
   double detect_camera(int cam, const slam::Estimator& est);  // ms spent
   struct Cam {
     geometry::PinholeCamera model;
