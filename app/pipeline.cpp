@@ -63,6 +63,14 @@ double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
   return e.dot(ldlt.solve(e));
 }
 
+// NEES of one 3-vector block of the state against its marginal covariance.
+double block_nees(const slam::FilterState& s, int pos, const Eigen::Vector3d& truth) {
+  const Eigen::Vector3d e = truth - s.x.segment<3>(pos);
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(s.P.block<3, 3>(pos, pos));
+  if (ldlt.info() != Eigen::Success) return eval::kNaN;
+  return e.dot(ldlt.solve(e));
+}
+
 // What a closed loop adds to the open-loop step: bring the truth to t before anything is
 // measured, and compute the commands from the updated estimate (filling the step's record).
 struct LoopHooks {
@@ -154,6 +162,10 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
       a.p_est = s.x.segment<3>(pos);
       a.v_est = s.x.segment<3>(pos + 3);
       a.p_sigma = s.P.block<3, 3>(pos, pos).diagonal().cwiseMax(0.0).cwiseSqrt();
+      if (k > 0) {
+        a.nees_p = block_nees(s, pos, tr.position);
+        a.nees_v = block_nees(s, pos + 3, tr.velocity);
+      }
       x_true.segment<3>(pos) = tr.position;
       x_true.segment<3>(pos + 3) = tr.velocity;
       st.agents.push_back(a);

@@ -92,6 +92,8 @@ Metrics compute_metrics(const RunRecord& run) {
       n_phases, std::vector<ErrorAccumulator>(n_agents));
   std::vector<ErrorAccumulator> total_err(n_agents);
   std::vector<MeanAccumulator> phase_nees(n_phases);
+  std::vector<std::vector<MeanAccumulator>> phase_nees_p(n_agents, std::vector<MeanAccumulator>(n_phases)),
+      phase_nees_v = phase_nees_p;
   MeanAccumulator run_nees;
   std::vector<double> t_predict, t_update, t_init, t_total, t_render, t_detect, t_match;
 
@@ -133,6 +135,8 @@ Metrics compute_metrics(const RunRecord& run) {
       const Eigen::Vector3d e = s.agents[a].p_true - s.agents[a].p_est;
       phase_err[s.phase][a].add(e);
       total_err[a].add(e);
+      phase_nees_p[a][s.phase].add(s.agents[a].nees_p);
+      phase_nees_v[a][s.phase].add(s.agents[a].nees_v);
     }
   }
 
@@ -145,6 +149,14 @@ Metrics compute_metrics(const RunRecord& run) {
   }
   for (const ErrorAccumulator& acc : total_err) m.table4.total.push_back(acc.result());
   m.nees.mean = run_nees.result();
+  for (std::size_t a = 0; a < n_agents; ++a) {
+    auto& pos = m.nees.position_per_phase.emplace_back();
+    auto& vel = m.nees.velocity_per_phase.emplace_back();
+    for (std::size_t p = 0; p < n_phases; ++p) {
+      pos.push_back(phase_nees_p[a][p].result());
+      vel.push_back(phase_nees_v[a][p].result());
+    }
+  }
 
   std::vector<std::vector<const LandmarkRecord*>> by_phase(n_phases);
   std::vector<const LandmarkRecord*> all;

@@ -52,6 +52,9 @@ struct NeesMetrics {
   double mean = kNaN;                  // over steps k > 0, ignoring NaN
   std::vector<double> per_phase_mean;  // one per phase, ignoring NaN
   std::vector<double> per_step;        // aligned with RunRecord::steps (all of them)
+  // Per agent (RunRecord::agent_names order), per phase: mean of the position and of the
+  // velocity NEES (3 dof each, expected 3 for a consistent filter).
+  std::vector<std::vector<double>> position_per_phase, velocity_per_phase;
 };
 
 struct Stats {

@@ -158,8 +158,31 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
       ph.agents.push_back(a);
     }
   };
+  // Block NEES of phase `index`, from each run's nees.per_agent (absent in older metrics.json).
+  auto block_nees = [&](MonteCarloPhase& ph, std::size_t index) {
+    const json& first = metrics.front().at("nees");
+    if (!first.contains("per_agent")) return;
+    for (auto it = first.at("per_agent").begin(); it != first.at("per_agent").end(); ++it) {
+      BlockNees b;
+      b.agent = it.key();
+      std::vector<double> pos, vel;
+      for (const auto& mj : metrics) {
+        const json& n = mj.at("nees");
+        if (!n.contains("per_agent") || !n.at("per_agent").contains(b.agent)) continue;
+        const json& a = n.at("per_agent").at(b.agent);
+        const json& p = a.at("position_per_phase_mean");
+        const json& v = a.at("velocity_per_phase_mean");
+        if (index < p.size()) pos.push_back(number_or_nan(p[index]));
+        if (index < v.size()) vel.push_back(number_or_nan(v[index]));
+      }
+      b.position = spread_of(pos);
+      b.velocity = spread_of(vel);
+      ph.blocks.push_back(b);
+    }
+  };
   for (std::size_t i = 0; i < phases.size(); ++i) {
     bounds_count(phases[i], false);
+    block_nees(phases[i], i);
     table4_spread(phases[i], [](const json& mj, std::size_t idx) -> const json* {
       const auto& ps = mj.at("table4").at("phases");
       return idx < ps.size() ? &ps[idx].at("agents") : nullptr;
@@ -192,6 +215,8 @@ void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs
               {"nees_mean", p.mean_nees}};
       for (const auto& a : p.agents)
         jp["mse"][a.agent] = {spread(a.mse[0]), spread(a.mse[1]), spread(a.mse[2])};
+      for (const auto& b : p.blocks)
+        jp["nees_blocks"][b.agent] = {{"position", spread(b.position)}, {"velocity", spread(b.velocity)}};
       j["phases"].push_back(jp);
     }
     out.push_back(j);
@@ -232,8 +257,19 @@ std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries) 
         for (const auto& sp : a.mse) s += fmt::format(" {:>7.4f}±{:<7.4f}", sp.mean, sp.std);
       s += "\n";
     }
+    if (m.phases.front().blocks.empty()) continue;
+    s += fmt::format("{:<10}", "NEES/block");
+    for (const auto& b : m.phases.front().blocks)
+      for (const char* q : {"pos", "vel"}) s += fmt::format(" {:>11}", b.agent + " " + q);
+    s += "\n";
+    for (const auto& p : m.phases) {
+      if (p.blocks.empty()) continue;
+      s += fmt::format("{:<10}", p.name);
+      for (const auto& b : p.blocks) s += fmt::format(" {:>11.2f} {:>11.2f}", b.position.mean, b.velocity.mean);
+      s += "\n";
+    }
   }
-  s += "(MSE in m^2: mean ± std over the runs)\n";
+  s += "(MSE in m^2: mean ± std over the runs; NEES/block: 3 dof each, 3 when consistent)\n";
   return s;
 }
 

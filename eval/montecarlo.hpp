@@ -23,6 +23,13 @@ struct AgentSpread {
   Spread mse[3];  // x, y, z over the runs
 };
 
+// One agent's position and velocity NEES (3 dof each; a consistent filter averages 3), the
+// per-run phase means spread over the runs: which block makes the total NEES off.
+struct BlockNees {
+  std::string agent;
+  Spread position, velocity;
+};
+
 struct MonteCarloPhase {
   std::string name;  // a phase, or "total"
   double t_start = 0, t_end = 0;
@@ -31,6 +38,7 @@ struct MonteCarloPhase {
   double fraction_inside = kNaN;
   double mean_nees = kNaN;  // average NEES averaged over the phase's steps
   std::vector<AgentSpread> agents;  // Table 4 of the phase over the runs
+  std::vector<BlockNees> blocks;    // phases only (empty for "total" and for older runs)
 };
 
 struct MonteCarloSummary {

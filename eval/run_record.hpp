@@ -18,6 +18,9 @@ struct AgentStep {
   Eigen::Vector3d p_true = Eigen::Vector3d::Zero(), v_true = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_est = Eigen::Vector3d::Zero(), v_est = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_sigma = Eigen::Vector3d::Zero();  // sqrt of diag of the position covariance
+  // NEES of the position and of the velocity alone (3 dof each, their marginal covariances):
+  // says which block of the state is over- or underconfident when the total is off.
+  double nees_p = kNaN, nees_v = kNaN;
 };
 
 // Closed loop only (paper section 6): one UAV's formation at one step. "true" values come from

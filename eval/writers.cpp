@@ -116,9 +116,17 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
   json per_phase = json::array(), per_step = json::array();
   for (double v : m.nees.per_phase_mean) per_phase.push_back(num(v));
   for (double v : m.nees.per_step) per_step.push_back(num(v));
+  json per_agent = json::object();
+  for (std::size_t a = 0; a < m.nees.position_per_phase.size() && a < run.agent_names.size(); ++a) {
+    json pos = json::array(), vel = json::array();
+    for (double v : m.nees.position_per_phase[a]) pos.push_back(num(v));
+    for (double v : m.nees.velocity_per_phase[a]) vel.push_back(num(v));
+    per_agent[run.agent_names[a]] = {{"position_per_phase_mean", pos}, {"velocity_per_phase_mean", vel}};
+  }
   j["nees"] = {{"dof", m.nees.dof},
                {"mean", num(m.nees.mean)},
                {"per_phase_mean", per_phase},
+               {"per_agent", per_agent},
                {"per_step", per_step}};
 
   j["timings_ms"] = {{"predict", stats(m.timings_ms.predict)},
@@ -206,6 +214,7 @@ void write_steps_csv(const RunRecord& run, const fs::path& path) {
       }
     }
     for (const char* ax : {"x", "y", "z"}) fmt::format_to(out, ",{}_s{}", a, ax);
+    fmt::format_to(out, ",{}_nees_p,{}_nees_v", a, a);
   }
   fmt::format_to(out,
                  ",nees,landmarks,landmarks_visible,matches_offered,matches_accepted,initialised,"
@@ -219,6 +228,8 @@ void write_steps_csv(const RunRecord& run, const fs::path& path) {
       put3(b, as.v_true);
       put3(b, as.v_est);
       put3(b, as.p_sigma);
+      put(b, as.nees_p);
+      put(b, as.nees_v);
     }
     put(b, s.nees);
     fmt::format_to(out, ",{},{},{},{},{}", s.landmarks, s.landmarks_visible, s.matches_offered,

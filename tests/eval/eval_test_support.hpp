@@ -15,6 +15,7 @@ namespace wingman::eval::test {
 // at t = k. Errors p_est - p_true: k == 0 huge (must be skipped); lead (0.5,0,0) throughout;
 // uav1 (0,1,0) in phase 0 (k = 1..9) and (0,0,2) in phase 1 (k = 10..20); k == 21 is outside
 // every phase (phase -1) with a huge error. NEES = k except NaN at k = 5, dof 12.
+// Block NEES: position 1 (lead) and 2 (uav1); velocity 2 (lead) and k/2 (uav1, NaN at k = 5).
 // t_predict_ms = k, t_update_ms = 2k, t_init_ms = 0.
 // Landmarks: two initialised in phase 0 (one removed), none in phase 1, one with phase -1.
 inline RunRecord make_record() {
@@ -48,6 +49,8 @@ inline RunRecord make_record() {
         e = s.phase == 0 ? Eigen::Vector3d(0, 1, 0) : Eigen::Vector3d(0, 0, 2);
       }
       as.p_est = as.p_true + e;
+      as.nees_p = 1.0 + a;
+      as.nees_v = a == 0 ? 2.0 : (k == 5 ? kNaN : 0.5 * k);
       s.agents.push_back(as);
     }
     s.nees = k == 5 ? kNaN : k;

@@ -117,6 +117,18 @@ TEST(Metrics, NeesMeanIgnoresNaNAndInitialStep) {
   EXPECT_NEAR(m.nees.per_phase_mean[1], 15.0, 1e-12);
 }
 
+TEST(Metrics, BlockNeesPerAgentAndPhase) {
+  const Metrics m = compute_metrics(test::make_record());
+  ASSERT_EQ(m.nees.position_per_phase.size(), 2u);  // lead, uav1
+  ASSERT_EQ(m.nees.velocity_per_phase.size(), 2u);
+  EXPECT_DOUBLE_EQ(m.nees.position_per_phase[0][0], 1.0);
+  EXPECT_DOUBLE_EQ(m.nees.position_per_phase[1][1], 2.0);
+  EXPECT_DOUBLE_EQ(m.nees.velocity_per_phase[0][1], 2.0);
+  // uav1 velocity: phase 0 k = 1..9 without 5 -> 40 / 8 / 2; phase 1 k = 10..20 -> 15 / 2.
+  EXPECT_NEAR(m.nees.velocity_per_phase[1][0], 2.5, 1e-12);
+  EXPECT_NEAR(m.nees.velocity_per_phase[1][1], 7.5, 1e-12);
+}
+
 TEST(Metrics, SummariseMedianAndP95) {
   std::vector<double> v;
   for (int i = 100; i >= 1; --i) v.push_back(i);  // unsorted on purpose

@@ -81,6 +81,29 @@ TEST(MonteCarlo, BoundsAverageAndFractionInsidePerPhase) {
   EXPECT_NEAR(m.phases[2].agents[0].mse[0].mean, 0.3, 1e-12);
 }
 
+TEST(MonteCarlo, BlockNeesAveragedOverRunsPerPhase) {
+  TempDir tmp;
+  write_run(tmp.path / "r1", {6, 6, 6, 6}, 0.1, 0.1);
+  write_run(tmp.path / "r2", {6, 6, 6, 6}, 0.1, 0.1);
+  auto add_blocks = [&](const char* run, double pos0, double vel1) {
+    nlohmann::json m = nlohmann::json::parse(std::ifstream(tmp.path / run / "metrics.json"));
+    m["nees"]["per_agent"]["uav1"] = {{"position_per_phase_mean", {pos0, 3.0}},
+                                      {"velocity_per_phase_mean", {3.0, vel1}}};
+    std::ofstream(tmp.path / run / "metrics.json") << m.dump();
+  };
+  add_blocks("r1", 2.0, 1.0);
+  add_blocks("r2", 4.0, 2.0);
+  const MonteCarloSummary m = aggregate_runs("multi", {tmp.path / "r1", tmp.path / "r2"});
+  ASSERT_EQ(m.phases.size(), 3u);
+  ASSERT_EQ(m.phases[0].blocks.size(), 1u);
+  EXPECT_EQ(m.phases[0].blocks[0].agent, "uav1");
+  EXPECT_DOUBLE_EQ(m.phases[0].blocks[0].position.mean, 3.0);
+  EXPECT_DOUBLE_EQ(m.phases[0].blocks[0].position.max, 4.0);
+  EXPECT_DOUBLE_EQ(m.phases[1].blocks[0].velocity.mean, 1.5);
+  EXPECT_TRUE(m.phases[2].blocks.empty());  // "total" has none
+  EXPECT_NE(format_monte_carlo({m}).find("uav1 pos"), std::string::npos);
+}
+
 TEST(MonteCarlo, RunsWithDifferentStepsAreAnErrorNamingTheFile) {
   TempDir tmp;
   write_run(tmp.path / "r1", {6, 6, 6, 6}, 0.1, 0.1);

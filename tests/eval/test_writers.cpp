@@ -88,6 +88,8 @@ TEST(Writers, MetricsJsonHasTablesAndNullForNaN) {
   EXPECT_TRUE(j["nees"]["per_step"][5].is_null());
   EXPECT_DOUBLE_EQ(j["nees"]["per_step"][6].get<double>(), 6.0);
   EXPECT_EQ(j["nees"]["per_phase_mean"].size(), 2u);
+  EXPECT_DOUBLE_EQ(j["nees"]["per_agent"]["uav1"]["position_per_phase_mean"][1].get<double>(), 2.0);
+  EXPECT_DOUBLE_EQ(j["nees"]["per_agent"]["uav1"]["velocity_per_phase_mean"][1].get<double>(), 7.5);
 
   for (const char* t : {"predict", "update", "init", "total"}) {
     for (const char* s : {"mean", "median", "p95", "max"}) {
@@ -148,13 +150,14 @@ TEST(Writers, StepsCsvHeaderAndValues) {
   const std::vector<std::string> lines = read_lines(tmp.path() / "steps.csv");
   ASSERT_EQ(lines.size(), run.steps.size() + 1);
   const std::vector<std::string> header = split(lines[0], ',');
-  ASSERT_EQ(header.size(), 3u + 2u * 15u + 9u);
+  ASSERT_EQ(header.size(), 3u + 2u * 17u + 9u);
   EXPECT_EQ(header[0], "k");
   EXPECT_EQ(header[3], "lead_px_true");
   EXPECT_EQ(header[6], "lead_px_est");
   EXPECT_EQ(header[9], "lead_vx_true");
   EXPECT_EQ(header[15], "lead_sx");
-  EXPECT_EQ(header[18], "uav1_px_true");
+  EXPECT_EQ(header[18], "lead_nees_p");
+  EXPECT_EQ(header[20], "uav1_px_true");
   EXPECT_EQ(header.back(), "t_init_ms");
 
   auto col = [&](const std::string& name) {
@@ -171,8 +174,12 @@ TEST(Writers, StepsCsvHeaderAndValues) {
     EXPECT_EQ(std::stod(row[col("uav1_pz_est")]), run.steps[k].agents[1].p_est.z());
     EXPECT_EQ(std::stod(row[col("uav1_sz")]), run.steps[k].agents[1].p_sigma.z());
     EXPECT_EQ(std::stod(row[col("t_update_ms")]), run.steps[k].t_update_ms);
+    if (k != 5) {
+      EXPECT_EQ(std::stod(row[col("uav1_nees_v")]), run.steps[k].agents[1].nees_v);
+    }
   }
   EXPECT_EQ(split(lines[6], ',')[col("nees")], "nan");
+  EXPECT_EQ(split(lines[6], ',')[col("uav1_nees_v")], "nan");
 }
 
 TEST(Writers, LandmarksCsv) {
