@@ -15,6 +15,7 @@
 
 #include "app/pipeline.hpp"
 #include "app/progress.hpp"
+#include "app/rendered_frontend.hpp"
 #include "app/replay.hpp"
 #include "eval/metrics.hpp"
 #include "vision/features.hpp"
@@ -27,25 +28,32 @@ struct BenchOptions {
   std::string dataset;
   std::string variant;
   std::vector<std::string> detectors{"orb", "gftt_orb", "akaze", "sift"};
-  int max_features = 1000;
+  int max_features = 0;  // 0: the scenario's frontend.max_features
   bool quiet = false;
 };
 
 int bench_command(const BenchOptions& o) {
-  std::vector<vision::FeatureSettings> settings;
-  for (const auto& name : o.detectors) {
-    vision::FeatureSettings f;
+  for (const auto& name : o.detectors) {  // a typo is a usage error, before any loading
     try {
-      f.kind = vision::parse_detector(name);
-      f.max_features = o.max_features;
-      f.validate();
+      vision::parse_detector(name);
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());
     }
-    settings.push_back(f);
   }
   const Replay replay = load_replay(o.dataset, o.variant);
   const sim::Scenario& scn = replay.scenario;
+  // Each detector with the rest of the scenario's frontend section (bucketing, thresholds).
+  std::vector<vision::FeatureSettings> settings;
+  for (const auto& name : o.detectors) {
+    sim::FrontendSpec spec = scn.frontend;
+    spec.detector = name;
+    if (o.max_features > 0) spec.max_features = o.max_features;
+    try {
+      settings.push_back(feature_settings(spec));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+  }
 
   struct Row {
     std::string name;
@@ -107,7 +115,9 @@ Subcommand add_bench_frontend(CLI::App& parent) {
   cmd->add_option("--variant", o->variant, "Estimator settings of this variant (default: the dataset's)");
   cmd->add_option("--detector", o->detectors, "Detectors to compare (repeatable; default: all four)")
       ->check(CLI::IsMember({"orb", "gftt_orb", "akaze", "sift"}));
-  cmd->add_option("--max-features", o->max_features, "Features per frame")->check(CLI::Range(10, 100000));
+  cmd->add_option("--max-features", o->max_features,
+                  "Features per frame (default: the scenario's frontend.max_features)")
+      ->check(CLI::Range(10, 100000));
   cmd->add_flag("--quiet,-q", o->quiet, "No progress lines");
   return {cmd, [o] { return bench_command(*o); }};
 }

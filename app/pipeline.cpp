@@ -79,7 +79,7 @@ struct LoopHooks {
   // Dataset replay: frames and sensor samples from the dataset, not the renderer and the
   // synthetic source (a sample missing at step k is not fed).
   FrameSource frames;
-  vision::FeatureSettings features{};
+  std::optional<vision::FeatureSettings> features;  // empty: the scenario's frontend section
   std::function<std::optional<Eigen::Vector3d>(int k)> gps;
   std::function<std::optional<double>(int k, int uav)> altimeter, range;
 };
@@ -530,7 +530,8 @@ eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progre
 }  // namespace
 
 eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
-                           const ProgressFn& progress, const vision::FeatureSettings& features) {
+                           const ProgressFn& progress,
+                           const std::optional<vision::FeatureSettings>& features) {
   if (scn.closed_loop())
     throw std::invalid_argument(ds.root.string() +
                                 ": a dataset holds an open-loop flight; its scenario has a control: section");

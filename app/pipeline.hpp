@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "eval/run_record.hpp"
@@ -42,7 +43,7 @@ eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& re
 // seed it was rendered with) gives the truth, checked against the dataset's camera poses.
 eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
                            const ProgressFn& progress = {},
-                           const vision::FeatureSettings& features = {});
+                           const std::optional<vision::FeatureSettings>& features = std::nullopt);
 // run_scenario with the automatic GL backend (a synthetic scenario never makes a context).
 eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress = {},
                               const StateObserver& observer = {});

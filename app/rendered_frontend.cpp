@@ -53,9 +53,47 @@ std::string fmt_label(const std::string& name, double t) {
 
 }  // namespace
 
+vision::FeatureSettings feature_settings(const sim::FrontendSpec& spec) {
+  vision::FeatureSettings f;
+  f.kind = vision::parse_detector(spec.detector);
+  f.max_features = spec.max_features;
+  f.grid_cols = spec.grid_cols;
+  f.grid_rows = spec.grid_rows;
+  f.orb_fast_threshold = spec.orb_fast_threshold;
+  f.orb_levels = spec.orb_levels;
+  f.orb_scale_factor = static_cast<float>(spec.orb_scale_factor);
+  f.akaze_threshold = spec.akaze_threshold;
+  f.sift_contrast = spec.sift_contrast;
+  f.gftt_quality = spec.gftt_quality;
+  f.gftt_min_distance = spec.gftt_min_distance_px;
+  f.validate();
+  return f;
+}
+
+vision::TrackingSettings tracking_settings(const sim::FrontendSpec& spec) {
+  vision::TrackingSettings t;
+  t.gate_d2 = spec.tracking_gate_d2;
+  t.ratio = spec.tracking_ratio;
+  t.max_search_radius_px = spec.max_search_radius_px;
+  t.validate();
+  return t;
+}
+
+vision::CrossMatchSettings cross_match_settings(const sim::FrontendSpec& spec) {
+  vision::CrossMatchSettings c;
+  c.ratio = spec.cross_ratio;
+  c.max_epipolar_px = spec.max_epipolar_px;
+  c.max_reprojection_px = spec.max_reprojection_px;
+  c.validate();
+  return c;
+}
+
 RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav,
                                    render::GlBackend backend)
-    : scn_(scn), cam_uav_(std::move(cam_uav)), lead_(lead_settings(scn)) {
+    : scn_(scn),
+      cam_uav_(std::move(cam_uav)),
+      features_(feature_settings(scn.frontend)),
+      lead_(lead_settings(scn)) {
   render::Scene scene;
   try {
     scene = render::build_scene(scn);
@@ -71,11 +109,12 @@ RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> ca
 }
 
 RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav,
-                                   FrameSource frames, const vision::FeatureSettings& features)
+                                   FrameSource frames,
+                                   const std::optional<vision::FeatureSettings>& features)
     : scn_(scn),
       cam_uav_(std::move(cam_uav)),
       frames_(std::move(frames)),
-      features_(features),
+      features_(features ? *features : feature_settings(scn.frontend)),
       lead_(lead_settings(scn)) {
   init_cameras();
 }
@@ -85,6 +124,8 @@ void RenderedFrontend::init_cameras() {
   // The estimator rejects pairs under its minimum parallax; filtering them before the spread
   // selection lets it pick among pairs that can be initialised (with a 3 m baseline, most of
   // the image's outer cells are under 8 degrees and would be chosen, and rejected, every step).
+  tracking_ = tracking_settings(scn_.frontend);
+  cross_ = cross_match_settings(scn_.frontend);
   cross_.min_parallax_deg = scn_.estimator.min_parallax_deg;
   for (int u : cam_uav_) {
     Cam c;

@@ -59,14 +59,19 @@ struct LabelledPair {
 // Frames of filter camera `cam` at step k from somewhere other than the renderer (a dataset).
 using FrameSource = std::function<render::Frame(int cam, int k)>;
 
+// The scenario's `frontend:` section as the vision frontend's settings (validated).
+vision::FeatureSettings feature_settings(const sim::FrontendSpec& spec);
+vision::TrackingSettings tracking_settings(const sim::FrontendSpec& spec);
+vision::CrossMatchSettings cross_match_settings(const sim::FrontendSpec& spec);
+
 class RenderedFrontend {
  public:
   // cam_uav: the UAV index of each filter camera (all UAVs, or the single-UAV baseline's one).
   RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, render::GlBackend backend);
   // Replay: frames from `frames` (already with their image effects), no GL context; features
-  // as `features` says (bench-frontend compares detectors).
+  // as `features` says (bench-frontend compares detectors), else as the scenario says.
   RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, FrameSource frames,
-                   const vision::FeatureSettings& features = {});
+                   const std::optional<vision::FeatureSettings>& features = std::nullopt);
   ~RenderedFrontend();
   RenderedFrontend(const RenderedFrontend&) = delete;
   RenderedFrontend& operator=(const RenderedFrontend&) = delete;

@@ -11,6 +11,7 @@
 
 #include "geometry/camera.hpp"
 #include "sim/control_spec.hpp"
+#include "sim/frontend_spec.hpp"
 #include "sim/world.hpp"
 
 namespace wingman::sim {
@@ -162,6 +163,7 @@ struct Scenario {
   EstimatorSpec estimator{};
   ControlSpec control{};  // enabled: closed loop (section 6)
   WorldSpec world{};  // what `wingman render` draws (sim/world.hpp)
+  FrontendSpec frontend{};  // rendered measurements: the vision frontend's settings
 
   double dt() const { return 1.0 / rate; }
   int num_steps() const;  // steps after t = 0

@@ -845,9 +845,63 @@ void parse_world(const Ctx& ctx, const Field& f, WorldSpec& w) {
     ctx.fail(ff ? ff->loc() : f.loc(), fmt::format("far ({}) must exceed near ({})", w.far, w.near));
 }
 
+// frontend: detector, features and bucketing grid, per-detector thresholds, tracking and
+// cross-UAV matching (rendered measurements; a synthetic run ignores it).
+void parse_frontend(const Ctx& ctx, const Field& f, FrontendSpec& fe) {
+  MapView m(ctx, f, {"detector", "max_features", "grid", "orb", "akaze", "sift", "gftt", "tracking",
+                     "cross_matching"});
+  if (auto d = m.get("detector")) {
+    static const std::vector<std::string_view> kinds = {"orb", "akaze", "sift", "gftt_orb"};
+    const std::string& s = scalar_of(ctx, *d, "a detector name");
+    if (std::find(kinds.begin(), kinds.end(), s) == kinds.end())
+      ctx.fail(d->loc(), fmt::format("unknown detector '{}' (expected orb, akaze, sift or gftt_orb){}", s,
+                                     suggestion(s, kinds)));
+    fe.detector = s;
+  }
+  integer(ctx, m, "max_features", fe.max_features, 1);
+  if (auto g = m.get("grid")) {
+    if (!g->node.IsSequence() || g->node.size() != 2)
+      ctx.fail(g->loc(), fmt::format("expected [columns, rows], got {}", describe(g->node)));
+    fe.grid_cols = read_int(ctx, Field{g->node[0], g->key_mark, index_path(g->path, 0)}, 1);
+    fe.grid_rows = read_int(ctx, Field{g->node[1], g->key_mark, index_path(g->path, 1)}, 1);
+  }
+  if (auto x = m.get("orb")) {
+    MapView o(ctx, *x, {"fast_threshold", "levels", "scale_factor"});
+    integer(ctx, o, "fast_threshold", fe.orb_fast_threshold, 1);
+    integer(ctx, o, "levels", fe.orb_levels, 1);
+    num(ctx, o, "scale_factor", fe.orb_scale_factor, in(1, 2, true, false));
+  }
+  if (auto x = m.get("akaze")) {
+    MapView a(ctx, *x, {"threshold"});
+    num(ctx, a, "threshold", fe.akaze_threshold, gt(0));
+  }
+  if (auto x = m.get("sift")) {
+    MapView a(ctx, *x, {"contrast_threshold"});
+    num(ctx, a, "contrast_threshold", fe.sift_contrast, gt(0));
+  }
+  if (auto x = m.get("gftt")) {
+    MapView a(ctx, *x, {"quality", "min_distance_px"});
+    num(ctx, a, "quality", fe.gftt_quality, in(0, 1, true, true));
+    num(ctx, a, "min_distance_px", fe.gftt_min_distance_px, ge(0));
+  }
+  if (auto x = m.get("tracking")) {
+    MapView t(ctx, *x, {"gate_d2", "ratio", "max_search_radius_px"});
+    num(ctx, t, "gate_d2", fe.tracking_gate_d2, gt(0));
+    num(ctx, t, "ratio", fe.tracking_ratio, in(0, 1, true, false));
+    num(ctx, t, "max_search_radius_px", fe.max_search_radius_px, ge(0));
+  }
+  if (auto x = m.get("cross_matching")) {
+    MapView c(ctx, *x, {"ratio", "max_epipolar_px", "max_reprojection_px"});
+    num(ctx, c, "ratio", fe.cross_ratio, in(0, 1, true, false));
+    num(ctx, c, "max_epipolar_px", fe.max_epipolar_px, gt(0));
+    num(ctx, c, "max_reprojection_px", fe.max_reprojection_px, gt(0));
+  }
+}
+
 // The sections a variant may override; the top level parses them with the same code.
-const std::vector<std::string_view> kCommonKeys = {"seed",   "duration", "noise",     "landmarks",
-                                                   "phases", "outages",  "estimator", "control"};
+const std::vector<std::string_view> kCommonKeys = {"seed",      "duration", "noise",   "landmarks",
+                                                   "phases",    "outages",  "estimator", "control",
+                                                   "frontend"};
 
 void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& prov) {
   if (auto f = m.get("seed")) s.seed = read_seed(ctx, *f);
@@ -858,6 +912,7 @@ void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& pro
   if (auto f = m.get("outages")) parse_outages(ctx, *f, s.outages, prov);
   if (auto f = m.get("estimator")) parse_estimator(ctx, *f, s.estimator, prov);
   if (auto f = m.get("control")) parse_control(ctx, *f, s.control, s.uavs);
+  if (auto f = m.get("frontend")) parse_frontend(ctx, *f, s.frontend);
 }
 
 std::string uav_names(const Scenario& s) {
@@ -938,7 +993,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   const std::vector<std::string_view> top_keys = {
       "name",  "duration",  "rate",   "seed",    "measurements", "lead",    "uavs",
       "noise", "landmarks", "phases", "outages", "estimator",    "control",
-      "variants", "world"};
+      "variants", "world", "frontend"};
   if (!root.IsMap()) {
     ctx.fail(root.Mark(), "",
              fmt::format("expected a map of scenario settings at the top level, got {}",

@@ -545,6 +545,84 @@ TEST(ScenarioYaml, RenderedMeasurementsParse) {
             MeasurementMode::Synthetic);
 }
 
+TEST(ScenarioYaml, FrontendSectionParsesAndVariantsOverrideIt) {
+  const std::string yaml = doc(R"(
+measurements: rendered
+frontend:
+  detector: gftt_orb
+  max_features: 400
+  grid: [6, 5]
+  orb: {fast_threshold: 15, levels: 3, scale_factor: 1.3}
+  gftt: {quality: 0.01, min_distance_px: 7}
+  tracking: {gate_d2: 11.8, ratio: 0.7, max_search_radius_px: 80}
+  cross_matching: {ratio: 0.75, max_epipolar_px: 4, max_reprojection_px: 3}
+variants:
+  - name: a
+  - name: b
+    frontend: {detector: akaze, akaze: {threshold: 0.001}}
+)");
+  const auto v = parse_scenarios(yaml, "scn.yaml");
+  ASSERT_EQ(v.size(), 2u);
+  const FrontendSpec& f = v[0].frontend;
+  EXPECT_EQ(f.detector, "gftt_orb");
+  EXPECT_EQ(f.max_features, 400);
+  EXPECT_EQ(f.grid_cols, 6);
+  EXPECT_EQ(f.grid_rows, 5);
+  EXPECT_EQ(f.orb_fast_threshold, 15);
+  EXPECT_EQ(f.orb_levels, 3);
+  EXPECT_DOUBLE_EQ(f.orb_scale_factor, 1.3);
+  EXPECT_DOUBLE_EQ(f.gftt_quality, 0.01);
+  EXPECT_DOUBLE_EQ(f.gftt_min_distance_px, 7);
+  EXPECT_DOUBLE_EQ(f.tracking_gate_d2, 11.8);
+  EXPECT_DOUBLE_EQ(f.tracking_ratio, 0.7);
+  EXPECT_DOUBLE_EQ(f.max_search_radius_px, 80);
+  EXPECT_DOUBLE_EQ(f.cross_ratio, 0.75);
+  EXPECT_DOUBLE_EQ(f.max_epipolar_px, 4);
+  EXPECT_DOUBLE_EQ(f.max_reprojection_px, 3);
+  // The variant changes the detector and keeps the rest of the base section.
+  EXPECT_EQ(v[1].frontend.detector, "akaze");
+  EXPECT_DOUBLE_EQ(v[1].frontend.akaze_threshold, 0.001);
+  EXPECT_EQ(v[1].frontend.max_features, 400);
+  // Defaults without the section.
+  EXPECT_EQ(parse_scenarios("measurements: rendered\n", "scn.yaml").front().frontend.detector, "orb");
+}
+
+TEST(ScenarioYaml, FrontendErrorsNameLineAndKey) {
+  const std::string bad_detector = doc(R"(
+frontend:
+  detector: surf
+)");
+  std::string e = error_of(bad_detector);
+  EXPECT_THAT(e, StartsWith(at_line(bad_detector, "detector")));
+  EXPECT_THAT(e, HasSubstr("frontend.detector"));
+  EXPECT_THAT(e, HasSubstr("unknown detector 'surf'"));
+
+  const std::string bad_grid = doc(R"(
+frontend:
+  grid: [8]
+)");
+  EXPECT_THAT(error_of(bad_grid), HasSubstr("frontend.grid"));
+  const std::string zero_cols = doc(R"(
+frontend:
+  grid: [0, 4]
+)");
+  EXPECT_THAT(error_of(zero_cols), HasSubstr("frontend.grid[0]"));
+
+  const std::string bad_ratio = doc(R"(
+frontend:
+  tracking: {ratio: 1.5}
+)");
+  e = error_of(bad_ratio);
+  EXPECT_THAT(e, StartsWith(at_line(bad_ratio, "ratio")));
+  EXPECT_THAT(e, HasSubstr("frontend.tracking.ratio"));
+
+  const std::string unknown = doc(R"(
+frontend:
+  orb: {levles: 3}
+)");
+  EXPECT_THAT(error_of(unknown), HasSubstr("unknown key 'levles'"));
+}
+
 TEST(ScenarioModel, SensorsOfFollowsTable1) {
   using S = Sensor;
   EXPECT_EQ(sensors_of(Config::C1), (std::vector<S>{S::Landmarks, S::LeadProjection, S::Gps}));
