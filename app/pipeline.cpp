@@ -276,7 +276,10 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
         ++accepted;
         ++oc.accepted;
         if (outlier) ++oc.outliers_accepted;
-        if (fe) fe->accepted(labelled[i], k);
+        if (fe) {
+          fe->accepted(labelled[i], k);
+          rec.frontend.accepted_error_px.push_back(labelled[i].error_px);
+        }
       }
     }
 

@@ -238,10 +238,13 @@ std::vector<LabelledCorrespondence> RenderedFrontend::track(
     c.tracked.push_back(tc.uv);
     const auto it = truth_.find(tc.id);
     // No truth (no rendered surface where it was first seen): counted as an outlier.
-    lc.outlier = it == truth_.end() || !it->second ||
-                 vision::label_landmark_observation(*it->second, tc.uv, c.model, c.true_pose,
-                                                    c.frame.depth)
-                         .label != vision::Label::Inlier;
+    lc.outlier = true;
+    if (it != truth_.end() && it->second) {
+      const auto lr = vision::label_landmark_observation(*it->second, tc.uv, c.model, c.true_pose,
+                                                         c.frame.depth);
+      lc.outlier = lr.label != vision::Label::Inlier;
+      lc.error_px = lr.reprojection_px;
+    }
     out.push_back(lc);
   }
   return out;

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <unordered_map>
@@ -47,6 +48,7 @@ struct LabelledCorrespondence {
   slam::Correspondence c;
   int keypoint = -1;
   bool outlier = false;  // > 3 px from the true projection, occluded, or no truth
+  double error_px = std::numeric_limits<double>::quiet_NaN();  // to the true projection
 };
 
 // A cross-UAV pixel pair for initialisation, with its label and what the store needs.

@@ -195,6 +195,14 @@ Metrics compute_metrics(const RunRecord& run) {
     if (f.lead_in_view > 0)
       m.frontend.lead_detection_rate = static_cast<double>(f.lead_detected) / f.lead_in_view;
     m.frontend.lead_error_px = summarise(f.lead_error_px);
+    m.frontend.accepted_error_px = summarise(f.accepted_error_px);
+    m.frontend.accepted_error_histogram.assign(std::size(FrontendMetrics::kErrorBins) + 1, 0);
+    for (double e : f.accepted_error_px) {
+      if (!std::isfinite(e)) continue;
+      const auto* bin = std::upper_bound(std::begin(FrontendMetrics::kErrorBins),
+                                         std::end(FrontendMetrics::kErrorBins), e);
+      ++m.frontend.accepted_error_histogram[bin - std::begin(FrontendMetrics::kErrorBins)];
+    }
     if (run.steps.size() > 1)
       m.frontend.detect_busy_ms_per_step = f.detect_busy_ms / static_cast<double>(run.steps.size() - 1);
   }

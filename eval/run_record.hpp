@@ -94,6 +94,9 @@ struct FrontendRecord {
   double lead_match_px = 10;
   double detect_busy_ms = 0;  // detection's whole duration over the run (partly behind rendering)
   std::vector<double> lead_error_px;  // detection to true projection, for the lead_detected frames
+  // Tracked correspondences the filter accepted: pixel to the landmark's true projection (NaN when
+  // the landmark has no truth). Says whether the labelled outliers are near misses or mismatches.
+  std::vector<double> accepted_error_px;
 };
 
 struct PhaseInfo {

@@ -148,7 +148,10 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
                      {"lead_match_px", num(run.frontend.lead_match_px)},
                      {"lead_detection_rate", num(f.lead_detection_rate)},
                      {"lead_error_px", stats(f.lead_error_px)},
-                     {"detect_busy_ms_per_step", num(f.detect_busy_ms_per_step)}};
+                     {"detect_busy_ms_per_step", num(f.detect_busy_ms_per_step)},
+                     {"accepted_error_px", stats(f.accepted_error_px)},
+                     {"accepted_error_histogram",
+                      {{"bin_edges_px", FrontendMetrics::kErrorBins}, {"counts", f.accepted_error_histogram}}}};
   }
   j["landmarks"] = {{"initialised", m.landmarks.initialised},
                     {"max_in_state", m.landmarks.max_in_state},
@@ -404,6 +407,8 @@ std::string format_summary(const Metrics& m, const RunRecord& run) {
                    "{} false\n",
                    f.lead_detected, f.lead_in_view, cell(f.lead_detection_rate, 0, 3),
                    cell(f.lead_error_px.median, 0, 3), cell(f.lead_error_px.p95, 0, 3), f.lead_false);
+    fmt::format_to(out, "Accepted tracked correspondences to their true projection: median {} px, p95 {} px\n",
+                   cell(f.accepted_error_px.median, 0, 3), cell(f.accepted_error_px.p95, 0, 3));
   }
   fmt::format_to(out, "Landmarks: {} initialised, at most {} in the state\n",
                  m.landmarks.initialised, m.landmarks.max_in_state);

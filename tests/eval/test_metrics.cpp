@@ -129,6 +129,18 @@ TEST(Metrics, BlockNeesPerAgentAndPhase) {
   EXPECT_NEAR(m.nees.velocity_per_phase[1][1], 7.5, 1e-12);
 }
 
+TEST(Metrics, FrontendAcceptedErrorHistogram) {
+  RunRecord r = test::make_record();
+  r.frontend.enabled = true;
+  r.frontend.accepted_error_px = {0.5, 1.5, 2.5, 4, 7, 20, kNaN, 0.2};
+  const Metrics m = compute_metrics(r);
+  ASSERT_TRUE(m.frontend.present);
+  // Bins [0,1) [1,2) [2,3) [3,5) [5,10) [10,inf); the NaN (no truth) is in none.
+  EXPECT_EQ(m.frontend.accepted_error_histogram, (std::vector<long>{2, 1, 1, 1, 1, 1}));
+  EXPECT_EQ(m.frontend.accepted_error_px.count, 7);
+  EXPECT_DOUBLE_EQ(m.frontend.accepted_error_px.max, 20);
+}
+
 TEST(Metrics, SummariseMedianAndP95) {
   std::vector<double> v;
   for (int i = 100; i >= 1; --i) v.push_back(i);  // unsorted on purpose
