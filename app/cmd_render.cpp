@@ -170,8 +170,8 @@ int render_command(const RenderOptions& o) {
     const double heading = lead.yaw - scn.world.lead.yaw_offset;
     writer.ground_truth("lead", pose(t_ns, lk.position, geometry::rot_z(heading), lk.velocity));
     if (scn.lead.gps) writer.gps("lead", {t_ns, sensors.gps(t)});
-    const Eigen::Matrix3d R_CW = truth.camera_R_CW(t);
     for (int j = 0; j < cams; ++j) {
+      const Eigen::Matrix3d R_CW = truth.camera_R_CW(j, t);
       const auto& u = scn.uavs[j];
       const sim::KinematicState q = truth.uav(j, t);
       const Eigen::Vector3d x_c = truth.camera(j, t).position;

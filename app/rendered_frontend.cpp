@@ -147,18 +147,17 @@ StageTimes RenderedFrontend::render_and_detect(const sim::Truth& truth, int k, d
   const auto t_start = Clock::now();
   render::LeadPose lead = render::lead_pose(scn_, t);
   lead.position = truth.lead(t).position;
-  const Eigen::Matrix3d R_CW = truth.camera_R_CW(t);
   // Camera j's detection runs on a second thread while camera j+1 renders (the GL context stays
   // on this thread; two detections never run at once, so the extractor is never shared).
   std::future<double> pending;
   for (std::size_t j = 0; j < cams_.size(); ++j) {
     Cam& c = cams_[j];
     const auto t0 = Clock::now();
-    c.true_pose = {R_CW, truth.camera(cam_uav_[j], t).position};
+    c.true_pose = {truth.camera_R_CW(cam_uav_[j], t), truth.camera(cam_uav_[j], t).position};
     if (frames_) {
       c.frame = frames_(static_cast<int>(j), k);
     } else {
-      c.frame = renderer_->render({c.model, R_CW, c.true_pose.position}, lead);
+      c.frame = renderer_->render({c.model, c.true_pose.R_CW, c.true_pose.position}, lead);
       effects_[j]->apply(c.frame);
     }
     st.render_ms += ms_since(t0);

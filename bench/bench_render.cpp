@@ -47,7 +47,7 @@ void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
   render::Renderer renderer(*ctx, render::build_scene(scn));
   const sim::OpenLoopTruth truth(scn);
   const double t = 20.0;
-  const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(t),
+  const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t),
                                 truth.camera(0, t).position};
   const render::LeadPose lead = render::lead_pose(scn, t);
   renderer.render(view, lead);  // warm-up: framebuffers, shader compilation

@@ -81,6 +81,10 @@ struct NoiseSpec {
   double outlier_max_px = 15.0;                // error norm uniform in [0, outlier_max_px]
   double gimbal_amplitude = 0.04;              // rad, e_r = A sin(w t)
   double gimbal_omega = 0.3;                   // rad/s
+  // false: the paper's e_r for every camera about both axes (DESIGN.md §2). true: A sin(w t + phi)
+  // with phi drawn per camera and axis from the seed, so that Monte Carlo runs see independent
+  // gimbal errors, as the filter's model assumes, instead of one realisation every run.
+  bool gimbal_random_phase = false;
 };
 
 // Static 3D points scattered over the ground below the flight (synthetic mode).

@@ -373,7 +373,7 @@ void parse_noise(const Ctx& ctx, const Field& f, NoiseSpec& n) {
   MapView m(ctx, f,
             {"pixel_sigma", "gps_sigma", "altimeter_sigma", "range_sigma", "ahrs_yaw_sigma",
              "outlier_fraction", "cooperative_outlier_fraction", "outlier_max_px",
-             "gimbal_amplitude", "gimbal_omega"});
+             "gimbal_amplitude", "gimbal_omega", "gimbal_random_phase"});
   num(ctx, m, "pixel_sigma", n.pixel_sigma, ge(0));
   num(ctx, m, "gps_sigma", n.gps_sigma, ge(0));
   num(ctx, m, "altimeter_sigma", n.altimeter_sigma, ge(0));
@@ -384,6 +384,7 @@ void parse_noise(const Ctx& ctx, const Field& f, NoiseSpec& n) {
   num(ctx, m, "outlier_max_px", n.outlier_max_px, ge(0));
   num(ctx, m, "gimbal_amplitude", n.gimbal_amplitude);
   num(ctx, m, "gimbal_omega", n.gimbal_omega);
+  boolean(ctx, m, "gimbal_random_phase", n.gimbal_random_phase);
 }
 
 void parse_landmarks(const Ctx& ctx, const Field& f, LandmarkFieldSpec& l) {

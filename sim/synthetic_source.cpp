@@ -58,7 +58,7 @@ std::optional<std::size_t> SyntheticSource::point_of(std::int64_t landmark) cons
 std::optional<Eigen::Vector2d> SyntheticSource::true_pixel(int uav, double t,
                                                            const Eigen::Vector3d& p) const {
   const auto cam = scn_.uavs[uav].camera.camera();
-  const Eigen::Vector3d p_C = truth_.camera_R_CW(t) * (p - truth_.camera(uav, t).position);
+  const Eigen::Vector3d p_C = truth_.camera_R_CW(uav, t) * (p - truth_.camera(uav, t).position);
   auto uv = cam.project(p_C);
   if (!uv || !cam.in_image(*uv)) return std::nullopt;
   return uv;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "geometry/rotation.hpp"
+#include "sim/rng.hpp"
 
 namespace wingman::sim {
 
@@ -42,9 +43,20 @@ KinematicState Truth::camera(int j, double t) const {
 
 Eigen::Matrix3d Truth::commanded_R_CW() const { return geometry::nadir_R_CW(); }
 
-Eigen::Matrix3d Truth::camera_R_CW(double t) const {
-  const double e = scn_.noise.gimbal_amplitude * std::sin(scn_.noise.gimbal_omega * t);
-  return geometry::gimbal_error(e) * commanded_R_CW();
+Truth::Truth(const Scenario& scn) : scn_(scn) {
+  gimbal_phase_.assign(scn.uavs.size(), Eigen::Vector2d::Zero());
+  if (!scn.noise.gimbal_random_phase) return;
+  std::mt19937_64 rng = make_stream(scn.seed, "gimbal");
+  std::uniform_real_distribution<double> phase(0.0, 2 * M_PI);
+  for (auto& p : gimbal_phase_) p = {phase(rng), phase(rng)};
+}
+
+Eigen::Matrix3d Truth::camera_R_CW(int j, double t) const {
+  const auto& n = scn_.noise;
+  const Eigen::Vector2d phi = gimbal_phase_.at(static_cast<std::size_t>(j));
+  const double ex = n.gimbal_amplitude * std::sin(n.gimbal_omega * t + phi.x());
+  const double ey = n.gimbal_amplitude * std::sin(n.gimbal_omega * t + phi.y());
+  return geometry::rot_x(ex) * geometry::rot_y(ey) * commanded_R_CW();
 }
 
 Eigen::Vector4d OpenLoopTruth::horizontal_extent() const {

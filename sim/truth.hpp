@@ -1,11 +1,13 @@
 // Ground-truth motion of the open-loop runs: the lead follows the lemniscate of paper eq. 66 and
 // every UAV the same curve shifted by its initial offset (DESIGN.md §3); the cameras carry the
-// gimbal error e_r(t) = A sin(w t) about their x and y axes, which the filter never sees.
+// gimbal error e_r(t) = A sin(w t) about their x and y axes (or with a phase per camera and
+// axis, noise.gimbal_random_phase), which the filter never sees.
 // Truth is the interface the synthetic source reads; closed_loop_truth.hpp is the other one.
 #pragma once
 
 #include <Eigen/Core>
 #include <utility>
+#include <vector>
 
 #include "sim/scenario.hpp"
 
@@ -22,7 +24,7 @@ KinematicState lemniscate(const LeadTrajectorySpec& spec, double t);
 // open-loop truth knows every instant in advance; the closed-loop one only the current step.
 class Truth {
  public:
-  explicit Truth(const Scenario& scn) : scn_(scn) {}
+  explicit Truth(const Scenario& scn);
   virtual ~Truth() = default;
   virtual KinematicState lead(double t) const = 0;
   virtual KinematicState uav(int j, double t) const = 0;  // the UAV's body position
@@ -30,14 +32,17 @@ class Truth {
   // Horizontal bounding box [xmin, ymin, xmax, ymax] of every agent over the run.
   virtual Eigen::Vector4d horizontal_extent() const = 0;
   KinematicState camera(int j, double t) const;  // body plus the offset d (eq. 59)
-  // The camera's true orientation: commanded nadir R_CW with the gimbal error applied. The
+  // Camera j's true orientation: commanded nadir R_CW with the gimbal error applied. The
   // gimbal holds it whatever the UAV's yaw.
-  Eigen::Matrix3d camera_R_CW(double t) const;
+  Eigen::Matrix3d camera_R_CW(int j, double t) const;
   Eigen::Matrix3d commanded_R_CW() const;
   const Scenario& scenario() const { return scn_; }
 
  protected:
   const Scenario& scn_;
+
+ private:
+  std::vector<Eigen::Vector2d> gimbal_phase_;  // per camera, about x and y
 };
 
 class OpenLoopTruth : public Truth {

@@ -64,7 +64,7 @@ TEST(RenderCli, WritesADatasetThatReadsBackAndMatchesADirectRender) {
   render::Renderer renderer(*ctx, render::build_scene(s));
   const double t = 0.1;
   const render::Frame f = renderer.render(
-      {s.uavs[1].camera.camera(), truth.camera_R_CW(t), truth.camera(1, t).position},
+      {s.uavs[1].camera.camera(), truth.camera_R_CW(1, t), truth.camera(1, t).position},
       render::lead_pose(s, t));
   EXPECT_EQ(cv::norm(ds.load_image("uav2", 100000000), f.rgb, cv::NORM_INF), 0);
   EXPECT_LT((ds.agent("uav2").camera_pose[1].p - truth.camera(1, t).position).norm(), 1e-6);

@@ -118,7 +118,7 @@ TEST_P(PaperSceneTest, SameScenarioAndSeedGiveIdenticalImages) {
   const sim::Scenario scn = paper();
   const sim::OpenLoopTruth truth(scn);
   const double t = 12.3;
-  const CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(t), truth.camera(0, t).position};
+  const CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t), truth.camera(0, t).position};
   Frame first, second;
   {
     Renderer r(ctx, build_scene(scn));
@@ -140,7 +140,7 @@ TEST_P(PaperSceneTest, LeadReferencePointIsWhereTheDepthSaysAndBothUavsSeeIt) {
   for (double t : {0.0, 30.0}) {
     const LeadPose lead = lead_pose(scn, t);
     for (int j = 0; j < 2; ++j) {
-      const CameraView view{scn.uavs[j].camera.camera(), truth.camera_R_CW(t),
+      const CameraView view{scn.uavs[j].camera.camera(), truth.camera_R_CW(j, t),
                             truth.camera(j, t).position};
       const Frame f = r.render(view, lead);
       const Eigen::Vector3d p_C = view.R_CW * (lead.position - view.x_c);

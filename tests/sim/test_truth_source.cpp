@@ -3,6 +3,7 @@
 
 #include <Eigen/Dense>
 
+#include "geometry/rotation.hpp"
 #include "sim/scenario.hpp"
 #include "sim/synthetic_source.hpp"
 #include "sim/truth.hpp"
@@ -32,9 +33,42 @@ TEST(Truth, AgentsStartAtTheirInitialPositionsAndShareTheCurve) {
   EXPECT_LT((truth.uav(1, 0).position - Eigen::Vector3d(1.5, 0, 17)).norm(), 1e-12);
   // Open loop: the formation offset is constant.
   EXPECT_LT((truth.uav(0, 42.0).position - truth.lead(42.0).position - Eigen::Vector3d(-1.5, 0, 15)).norm(), 1e-9);
-  const Eigen::Matrix3d R = truth.camera_R_CW(5.0);
+  const Eigen::Matrix3d R = truth.camera_R_CW(0, 5.0);
   EXPECT_LT((R * R.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
   EXPECT_GT((R - truth.commanded_R_CW()).norm(), 1e-3);  // the gimbal error is there
+}
+
+TEST(Truth, GimbalErrorIsThePapersSinusoidByDefault) {
+  const Scenario scn = paper_scenario();
+  const OpenLoopTruth truth(scn);
+  for (double t : {0.0, 3.7, 12.0}) {
+    const double e = scn.noise.gimbal_amplitude * std::sin(scn.noise.gimbal_omega * t);
+    const Eigen::Matrix3d expected = wingman::geometry::gimbal_error(e) * truth.commanded_R_CW();
+    for (int j = 0; j < 2; ++j) EXPECT_LT((truth.camera_R_CW(j, t) - expected).norm(), 1e-12);
+  }
+}
+
+TEST(Truth, RandomGimbalPhaseDiffersPerCameraAndSeedAndKeepsTheAmplitude) {
+  Scenario scn = paper_scenario();
+  scn.noise.gimbal_random_phase = true;
+  const OpenLoopTruth a(scn);
+  Scenario other_seed = scn;
+  other_seed.seed = scn.seed + 1;
+  const OpenLoopTruth b(other_seed);
+  const OpenLoopTruth a_again(scn);
+  const double t = 4.0;
+  EXPECT_GT((a.camera_R_CW(0, t) - a.camera_R_CW(1, t)).norm(), 1e-4);  // cameras independent
+  EXPECT_GT((a.camera_R_CW(0, t) - b.camera_R_CW(0, t)).norm(), 1e-4);  // seeds independent
+  EXPECT_LT((a.camera_R_CW(0, t) - a_again.camera_R_CW(0, t)).norm(), 1e-15);  // reproducible
+  // The error stays a rotation within the amplitude about each axis.
+  double max_angle = 0;
+  for (double tt = 0; tt < 30; tt += 0.1) {
+    const Eigen::Matrix3d E = a.camera_R_CW(1, tt) * a.commanded_R_CW().transpose();
+    EXPECT_LT((E * E.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+    max_angle = std::max(max_angle, Eigen::AngleAxisd(E).angle());
+  }
+  EXPECT_LE(max_angle, std::sqrt(2.0) * scn.noise.gimbal_amplitude + 1e-9);
+  EXPECT_GT(max_angle, 0.8 * scn.noise.gimbal_amplitude);
 }
 
 TEST(SyntheticSource, FieldDensityAndReproducibility) {
