@@ -51,8 +51,12 @@ struct GlFunctions {
 #define WINGMAN_GL_DECLARE(type, name) type name = nullptr;
   WINGMAN_GL_FUNCTIONS(WINGMAN_GL_DECLARE)
 #undef WINGMAN_GL_DECLARE
-  // Resolves every entry point; throws GlContextError naming the first one missing.
+  // Optional: GL 4.5 or ARB_clip_control (reversed-Z depth); null where the context lacks it.
+  PFNGLCLIPCONTROLPROC ClipControl = nullptr;
+  // Resolves every entry point; throws GlContextError naming the first one missing. The context
+  // must be current (the optional ones depend on its version and extensions).
   void load(const GlContext& ctx);
+  bool has_version_or_extension(int major, int minor, const char* extension) const;
 };
 
 }  // namespace wingman::render

@@ -24,10 +24,8 @@ uniform mat3 u_model_rot;
 out vec3 v_normal;
 out vec2 v_uv;
 out vec3 v_colour;
-out float v_depth;
 void main() {
   vec4 pc = u_model_view * vec4(a_pos, 1.0);
-  v_depth = pc.z;
   v_normal = u_model_rot * a_normal;
   v_uv = a_uv;
   v_colour = a_colour;
@@ -39,25 +37,25 @@ const char* kSceneFs = R"(#version 330 core
 in vec3 v_normal;
 in vec2 v_uv;
 in vec3 v_colour;
-in float v_depth;
 uniform sampler2D u_tex;
 uniform vec3 u_to_light;
 uniform float u_ambient;
 uniform float u_diffuse;
 uniform int u_unlit;
 layout(location = 0) out vec4 o_colour;
-layout(location = 1) out float o_depth;
 void main() {
   vec3 albedo = texture(u_tex, v_uv).rgb * v_colour;
   float shade = u_unlit != 0 ? 1.0
       : u_ambient + u_diffuse * max(dot(normalize(v_normal), u_to_light), 0.0);
   o_colour = vec4(albedo * shade, 1.0);
-  o_depth = v_depth;
 }
 )";
 
-// MSAA resolve: colour averaged over the samples; depth from sample 0, which the fragment shader
-// evaluated at the pixel centre (no per-sample shading), so depth never blends two surfaces.
+// MSAA resolve: colour averaged over the samples; window depth written to the single-sample depth
+// buffer, never blending two surfaces. Window depth is affine over a triangle, and the standard
+// 4x pattern has s0 + s3 = s1 + s2 = twice the pixel centre: when d0 + d3 == d1 + d2 the four
+// samples lie on one plane and their mean is the depth at the pixel centre; otherwise (an edge,
+// or another sample count) sample 0 is kept, at most 0.4 px from the centre.
 const char* kResolveVs = R"(#version 330 core
 void main() {
   vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
@@ -70,13 +68,20 @@ uniform sampler2DMS u_colour;
 uniform sampler2DMS u_depth;
 uniform int u_samples;
 layout(location = 0) out vec4 o_colour;
-layout(location = 1) out float o_depth;
+float depth(ivec2 p) {
+  float d0 = texelFetch(u_depth, p, 0).r;
+  if (u_samples != 4) return d0;
+  float d1 = texelFetch(u_depth, p, 1).r, d2 = texelFetch(u_depth, p, 2).r,
+        d3 = texelFetch(u_depth, p, 3).r;
+  float scale = max(max(abs(d0), abs(d1)), max(abs(d2), abs(d3)));
+  return abs(d0 + d3 - d1 - d2) <= 1e-5 * scale ? 0.25 * (d0 + d1 + d2 + d3) : d0;
+}
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec4 c = vec4(0.0);
   for (int i = 0; i < u_samples; ++i) c += texelFetch(u_colour, p, i);
   o_colour = c / float(u_samples);
-  o_depth = texelFetch(u_depth, p, 0).r;
+  gl_FragDepth = depth(p);
 }
 )";
 
@@ -93,10 +98,35 @@ struct GpuMaterial {
 
 struct Target {
   int w = 0, h = 0, samples = 1;
-  GLuint ms_fbo = 0, ms_colour = 0, ms_depthval = 0, ms_depth = 0;
-  GLuint fbo = 0, colour = 0, depthval = 0, depth = 0;
-  cv::Mat rgba;  // readback buffers, reused
+  GLuint ms_fbo = 0, ms_colour = 0, ms_depth = 0;  // textures: the resolve pass reads them
+  GLuint fbo = 0, colour = 0, depth = 0;           // what is read back
+  cv::Mat rgba;  // readback buffer, reused
 };
+
+// Window depth d = alpha + beta / z of the camera-frame depth z, exactly as the rasteriser
+// interpolates it (1/z is affine in screen space); read back, z = beta / (d - alpha). Reversed-Z
+// (near at 1, far at 0, with glClipControl's [0, 1] depth range) keeps float's relative precision
+// at every distance (about 1e-7 z); without clip control the classic mapping still resolves a
+// millimetre at 20 m. `clear` is the value where nothing was drawn.
+struct DepthMap {
+  bool reversed = false;
+  double alpha = 0, beta = 0;
+  float clear = 1;
+};
+
+DepthMap depth_map(double n, double f, bool reversed) {
+  if (reversed) return {true, -n / (f - n), n * f / (f - n), 0.f};
+  return {false, f / (f - n), -n * f / (f - n), 1.f};
+}
+
+// Window depth to metres along the optical axis, in place; 0 where nothing was drawn.
+void to_metric_depth(cv::Mat& d, const DepthMap& m) {
+  for (int r = 0; r < d.rows; ++r) {
+    float* p = d.ptr<float>(r);
+    for (int c = 0; c < d.cols; ++c)
+      p[c] = p[c] != m.clear ? static_cast<float>(m.beta / (p[c] - m.alpha)) : 0.f;
+  }
+}
 
 Eigen::Matrix4f to_float(const Eigen::Matrix4d& m) { return m.cast<float>(); }
 
@@ -119,6 +149,7 @@ struct Renderer::Impl {
   std::map<std::pair<int, int>, Target> targets;
   Scene info;  // light, sky, near, far, msaa (meshes cleared)
   float max_aniso = 1;
+  DepthMap depth;  // reversed-Z where the context has glClipControl
 
   GLuint compile(GLenum type, const char* src) {
     GLuint s = gl.CreateShader(type);
@@ -244,20 +275,14 @@ struct Renderer::Impl {
       gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
       return x;
     };
-    const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     gl.GenFramebuffers(1, &t.fbo);
     gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     t.colour = tex2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE);
-    t.depthval = tex2d(GL_R32F, GL_RED, GL_FLOAT);
     gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.colour, 0);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, t.depthval, 0);
-    if (t.samples == 1) {
-      gl.GenRenderbuffers(1, &t.depth);
-      gl.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
-      gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, w, h);
-      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
-    }
-    gl.DrawBuffers(2, bufs);
+    gl.GenRenderbuffers(1, &t.depth);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
+    gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, w, h);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
     check_fbo("resolve");
     if (t.samples > 1) {
       gl.GenFramebuffers(1, &t.ms_fbo);
@@ -270,16 +295,11 @@ struct Renderer::Impl {
         return x;
       };
       t.ms_colour = texms(GL_RGBA8);
-      t.ms_depthval = texms(GL_R32F);
+      t.ms_depth = texms(GL_DEPTH_COMPONENT32F);
       gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D_MULTISAMPLE,
                               t.ms_colour, 0);
-      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D_MULTISAMPLE,
-                              t.ms_depthval, 0);
-      gl.GenRenderbuffers(1, &t.ms_depth);
-      gl.BindRenderbuffer(GL_RENDERBUFFER, t.ms_depth);
-      gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, t.samples, GL_DEPTH_COMPONENT32F, w, h);
-      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.ms_depth);
-      gl.DrawBuffers(2, bufs);
+      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D_MULTISAMPLE,
+                              t.ms_depth, 0);
       check_fbo("multisample");
     }
     t.rgba.create(h, w, CV_8UC4);
@@ -289,11 +309,10 @@ struct Renderer::Impl {
   void release() {
     for (auto& [k, t] : targets) {
       GLuint fbos[2] = {t.fbo, t.ms_fbo};
-      GLuint texs[4] = {t.colour, t.depthval, t.ms_colour, t.ms_depthval};
-      GLuint rbs[2] = {t.depth, t.ms_depth};
+      GLuint texs[3] = {t.colour, t.ms_colour, t.ms_depth};
       gl.DeleteFramebuffers(2, fbos);
-      gl.DeleteTextures(4, texs);
-      gl.DeleteRenderbuffers(2, rbs);
+      gl.DeleteTextures(3, texs);
+      gl.DeleteRenderbuffers(1, &t.depth);
     }
     for (auto* list : {&static_meshes, &lead_meshes})
       for (auto& m : *list) {
@@ -323,6 +342,7 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.info.near = scene.near;
   I.info.far = scene.far;
   I.info.msaa = scene.msaa;
+  I.depth = depth_map(scene.near, scene.far, gl.ClipControl != nullptr);
   I.program = I.link(kSceneVs, kSceneFs);
   I.resolve_program = I.link(kResolveVs, kResolveFs);
   I.u_model_view = gl.GetUniformLocation(I.program, "u_model_view");
@@ -362,7 +382,7 @@ Renderer::~Renderer() {
 }
 
 Eigen::Matrix4d Renderer::projection(double fx, double fy, double cx, double cy, int w, int h,
-                                     double n, double f) {
+                                     double n, double f, bool reversed_z) {
   // Clip w = z (OpenCV camera looks along +z). Window x = u + 0.5 puts u = fx x/z + cx at the
   // centre of pixel column u; window y = v + 0.5 makes GL's row 0 the image's top row.
   Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
@@ -370,8 +390,11 @@ Eigen::Matrix4d Renderer::projection(double fx, double fy, double cx, double cy,
   P(0, 2) = 2 * (cx + 0.5) / w - 1;
   P(1, 1) = 2 * fy / h;
   P(1, 2) = 2 * (cy + 0.5) / h - 1;
-  P(2, 2) = (f + n) / (f - n);
-  P(2, 3) = -2 * f * n / (f - n);
+  // Clip z = a z + b: NDC z runs from -1 at near to 1 at far, or (reversed, for a [0, 1] clip
+  // range) from 1 at near to 0 at far; see DepthMap.
+  const DepthMap m = depth_map(n, f, reversed_z);
+  P(2, 2) = reversed_z ? m.alpha : (f + n) / (f - n);
+  P(2, 3) = reversed_z ? m.beta : -2 * f * n / (f - n);
   P(3, 2) = 1;
   return P;
 }
@@ -382,24 +405,23 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   Impl& I = *impl_;
   auto& gl = I.gl;
   Target& t = I.target(w, h);
-  const Eigen::Matrix4f P = to_float(projection(fx, fy, cx, cy, w, h, I.info.near, I.info.far));
+  const Eigen::Matrix4f P =
+      to_float(projection(fx, fy, cx, cy, w, h, I.info.near, I.info.far, I.depth.reversed));
   Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
   V.topLeftCorner<3, 3>() = view.R_CW;
   V.topRightCorner<3, 1>() = -view.R_CW * view.x_c;
 
   gl.BindFramebuffer(GL_FRAMEBUFFER, t.samples > 1 ? t.ms_fbo : t.fbo);
   gl.Viewport(0, 0, w, h);
+  if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   gl.Enable(GL_DEPTH_TEST);
-  gl.DepthFunc(GL_LESS);
+  gl.DepthFunc(I.depth.reversed ? GL_GREATER : GL_LESS);
   gl.Disable(GL_CULL_FACE);  // the y-flipped projection mirrors the winding; draw both faces
   if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
   const float sky[4] = {static_cast<float>(I.info.sky.x()), static_cast<float>(I.info.sky.y()),
                         static_cast<float>(I.info.sky.z()), 1.f};
-  const float zero[4] = {0, 0, 0, 0};
-  const float one = 1.f;
   gl.ClearBufferfv(GL_COLOR, 0, sky);
-  gl.ClearBufferfv(GL_COLOR, 1, zero);
-  gl.ClearBufferfv(GL_DEPTH, 0, &one);
+  gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
 
   gl.UseProgram(I.program);
   gl.UniformMatrix4fv(I.u_proj, 1, GL_FALSE, P.data());
@@ -434,12 +456,12 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
 
   if (t.samples > 1) {
     gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-    gl.Disable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_ALWAYS);  // depth test on so that gl_FragDepth is written
     gl.UseProgram(I.resolve_program);
     gl.ActiveTexture(GL_TEXTURE0);
     gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_colour);
     gl.ActiveTexture(GL_TEXTURE1);
-    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_depthval);
+    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_depth);
     gl.Uniform1i(I.r_colour, 0);
     gl.Uniform1i(I.r_depth, 1);
     gl.Uniform1i(I.r_samples, t.samples);
@@ -455,9 +477,9 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
   gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, t.rgba.data);
-  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-  gl.ReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, f.depth.data);
+  gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, f.depth.data);
   cv::cvtColor(t.rgba, f.rgb, cv::COLOR_RGBA2RGB);
+  to_metric_depth(f.depth, I.depth);
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
     throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while rendering");
   return f;
