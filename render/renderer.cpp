@@ -13,6 +13,10 @@ namespace wingman::render {
 
 namespace {
 
+// Lambert shading per vertex: the terrain's normals vary smoothly over its 2 m cells and the
+// objects are flat-shaded, so per-pixel lighting changed nothing visible, while llvmpipe's
+// fragment cost grows with every varying and instruction. The fragment shader is one texture
+// lookup times one colour.
 const char* kSceneVs = R"(#version 330 core
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
@@ -21,33 +25,28 @@ layout(location = 3) in vec3 a_colour;
 uniform mat4 u_model_view;
 uniform mat4 u_proj;
 uniform mat3 u_model_rot;
-out vec3 v_normal;
+uniform vec3 u_to_light;
+uniform float u_ambient;
+uniform float u_diffuse;
+uniform bool u_unlit;
 out vec2 v_uv;
 out vec3 v_colour;
 void main() {
-  vec4 pc = u_model_view * vec4(a_pos, 1.0);
-  v_normal = u_model_rot * a_normal;
+  float shade = u_unlit ? 1.0
+      : u_ambient + u_diffuse * max(dot(normalize(u_model_rot * a_normal), u_to_light), 0.0);
   v_uv = a_uv;
-  v_colour = a_colour;
-  gl_Position = u_proj * pc;
+  v_colour = a_colour * shade;
+  gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
 }
 )";
 
 const char* kSceneFs = R"(#version 330 core
-in vec3 v_normal;
 in vec2 v_uv;
 in vec3 v_colour;
 uniform sampler2D u_tex;
-uniform vec3 u_to_light;
-uniform float u_ambient;
-uniform float u_diffuse;
-uniform int u_unlit;
 layout(location = 0) out vec4 o_colour;
 void main() {
-  vec3 albedo = texture(u_tex, v_uv).rgb * v_colour;
-  float shade = u_unlit != 0 ? 1.0
-      : u_ambient + u_diffuse * max(dot(normalize(v_normal), u_to_light), 0.0);
-  o_colour = vec4(albedo * shade, 1.0);
+  o_colour = vec4(texture(u_tex, v_uv).rgb * v_colour, 1.0);
 }
 )";
 
