@@ -45,7 +45,8 @@ namespace wingman::render {
   X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers) X(PFNGLDRAWBUFFERSPROC, DrawBuffers)     \
   X(PFNGLREADBUFFERPROC, ReadBuffer) X(PFNGLREADPIXELSPROC, ReadPixels)                         \
   X(PFNGLPIXELSTOREIPROC, PixelStorei) X(PFNGLDRAWARRAYSPROC, DrawArrays)                       \
-  X(PFNGLDRAWELEMENTSPROC, DrawElements) X(PFNGLFINISHPROC, Finish)
+  X(PFNGLDRAWELEMENTSPROC, DrawElements) X(PFNGLFINISHPROC, Finish)                             \
+  X(PFNGLMULTIDRAWELEMENTSPROC, MultiDrawElements)
 
 struct GlFunctions {
 #define WINGMAN_GL_DECLARE(type, name) type name = nullptr;
