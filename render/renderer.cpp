@@ -245,7 +245,8 @@ struct Renderer::Impl {
     return p;
   }
 
-  GLuint upload_texture(const cv::Mat& img, bool repeat, bool mipmaps, double anisotropy) {
+  GLuint upload_texture(const cv::Mat& img, bool repeat, bool mipmaps, bool trilinear,
+                        double anisotropy) {
     cv::Mat rgba;
     if (img.channels() == 3)
       cv::cvtColor(img, rgba, cv::COLOR_RGB2RGBA);
@@ -266,7 +267,8 @@ struct Renderer::Impl {
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     if (mipmaps) {
       gl.GenerateMipmap(GL_TEXTURE_2D);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
+                       trilinear ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_NEAREST);
       if (max_aniso > 1 && anisotropy > 1)
         gl.TexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY,
                          std::min<float>(max_aniso, static_cast<float>(anisotropy)));
@@ -451,10 +453,12 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.r_depth = gl.GetUniformLocation(I.resolve_program, "u_depth");
   I.r_samples = gl.GetUniformLocation(I.resolve_program, "u_samples");
   gl.GenVertexArrays(1, &I.empty_vao);
-  I.white = I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, 1);
+  I.white =
+      I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, false, 1);
   for (const auto& m : scene.materials) {
     GpuMaterial g;
-    g.tex = m.texture.empty() ? 0 : I.upload_texture(m.texture, m.repeat, m.mipmaps, m.anisotropy);
+    g.tex = m.texture.empty() ? 0 : I.upload_texture(m.texture, m.repeat, m.mipmaps, m.trilinear,
+                                                         m.anisotropy);
     g.unlit = m.unlit;
     I.materials.push_back(g);
   }
