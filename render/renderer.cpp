@@ -162,8 +162,8 @@ struct Target {
 // Window depth d = alpha + beta / z of the camera-frame depth z, exactly as the rasteriser
 // interpolates it (1/z is affine in screen space); read back, z = beta / (d - alpha). Reversed-Z
 // (near at 1, far at 0, with glClipControl's [0, 1] depth range) keeps float's relative precision
-// at every distance (about 1e-7 z); without clip control the classic mapping still resolves a
-// millimetre at 20 m. `clear` is the value where nothing was drawn.
+// at every distance (worst 6 um at 20 m on llvmpipe); without clip control the classic mapping
+// (d crowding towards 1) is used: 2.7 mm at 20 m, 0.2 m at 400 m. `clear`: where nothing was drawn.
 struct DepthMap {
   bool reversed = false;
   double alpha = 0, beta = 0;
@@ -177,14 +177,16 @@ DepthMap depth_map(double n, double f, bool reversed) {
 
 // Window depth to metres along the optical axis, in place; 0 where nothing was drawn. Float and
 // branch-free so that it vectorises: in double it took 1.3 ms a megapixel, on the thread that
-// waits for the frame.
+// waits for the frame. d - alpha is formed as (d - clear) - (alpha - clear): exact for d near
+// the clear value, where the classic mapping's alpha (1.0001) rounded to float would cost mm.
 void to_metric_depth(cv::Mat& d, const DepthMap& m) {
-  const float alpha = static_cast<float>(m.alpha), beta = static_cast<float>(m.beta);
+  const float clear = m.clear, rest = static_cast<float>(m.alpha - m.clear),
+              beta = static_cast<float>(m.beta);
   for (int r = 0; r < d.rows; ++r) {
     float* p = d.ptr<float>(r);
     for (int c = 0; c < d.cols; ++c) {
-      const float z = beta / (p[c] - alpha);  // never 0 / 0: alpha lies outside [0, 1]
-      p[c] = p[c] != m.clear ? z : 0.f;       // a select, not a branch around the division
+      const float z = beta / ((p[c] - clear) - rest);  // never 0 / 0: alpha lies outside [0, 1]
+      p[c] = p[c] != clear ? z : 0.f;  // a select, not a branch around the division
     }
   }
 }
