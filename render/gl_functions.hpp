@@ -34,7 +34,6 @@ namespace wingman::render {
   X(PFNGLTEXPARAMETERIPROC, TexParameteri) X(PFNGLTEXPARAMETERFPROC, TexParameterf)             \
   X(PFNGLGENERATEMIPMAPPROC, GenerateMipmap) X(PFNGLACTIVETEXTUREPROC, ActiveTexture)           \
   X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                                    \
-  X(PFNGLTEXIMAGE2DMULTISAMPLEPROC, TexImage2DMultisample)                                      \
   X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers) X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)     \
   X(PFNGLFRAMEBUFFERTEXTURE2DPROC, FramebufferTexture2D)                                        \
   X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, FramebufferRenderbuffer)                                  \
@@ -46,7 +45,8 @@ namespace wingman::render {
   X(PFNGLREADBUFFERPROC, ReadBuffer) X(PFNGLREADPIXELSPROC, ReadPixels)                         \
   X(PFNGLPIXELSTOREIPROC, PixelStorei) X(PFNGLDRAWARRAYSPROC, DrawArrays)                       \
   X(PFNGLDRAWELEMENTSPROC, DrawElements) X(PFNGLFINISHPROC, Finish)                             \
-  X(PFNGLMULTIDRAWELEMENTSPROC, MultiDrawElements)
+  X(PFNGLMULTIDRAWELEMENTSPROC, MultiDrawElements) X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)   \
+  X(PFNGLCOLORMASKPROC, ColorMask)
 
 struct GlFunctions {
 #define WINGMAN_GL_DECLARE(type, name) type name = nullptr;

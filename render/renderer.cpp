@@ -52,38 +52,21 @@ void main() {
 }
 )";
 
-// MSAA resolve: colour averaged over the samples; window depth written to the single-sample depth
-// buffer, never blending two surfaces. Window depth is affine over a triangle, and the standard
-// 4x pattern has s0 + s3 = s1 + s2 = twice the pixel centre: when d0 + d3 == d1 + d2 the four
-// samples lie on one plane and their mean is the depth at the pixel centre; otherwise (an edge,
-// or another sample count) sample 0 is kept, at most 0.4 px from the centre.
-const char* kResolveVs = R"(#version 330 core
+// With MSAA, depth comes from a second, single-sample pass of the same geometry with this
+// program (no colour, no texture): the surface at the pixel centre, exactly as without MSAA, never
+// a blend of two surfaces at an edge. Colour is resolved by glBlitFramebuffer. On llvmpipe this
+// costs 12 ms less than one resolve shader averaging the colour samples and picking a depth.
+const char* kDepthVs = R"(#version 330 core
+layout(location = 0) in vec3 a_pos;
+uniform mat4 u_model_view;
+uniform mat4 u_proj;
 void main() {
-  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+  gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
 }
 )";
 
-const char* kResolveFs = R"(#version 330 core
-uniform sampler2DMS u_colour;
-uniform sampler2DMS u_depth;
-uniform int u_samples;
-layout(location = 0) out vec4 o_colour;
-float depth(ivec2 p) {
-  float d0 = texelFetch(u_depth, p, 0).r;
-  if (u_samples != 4) return d0;
-  float d1 = texelFetch(u_depth, p, 1).r, d2 = texelFetch(u_depth, p, 2).r,
-        d3 = texelFetch(u_depth, p, 3).r;
-  float scale = max(max(abs(d0), abs(d1)), max(abs(d2), abs(d3)));
-  return abs(d0 + d3 - d1 - d2) <= 1e-5 * scale ? 0.25 * (d0 + d1 + d2 + d3) : d0;
-}
-void main() {
-  ivec2 p = ivec2(gl_FragCoord.xy);
-  vec4 c = vec4(0.0);
-  for (int i = 0; i < u_samples; ++i) c += texelFetch(u_colour, p, i);
-  o_colour = c / float(u_samples);
-  gl_FragDepth = depth(p);
-}
+const char* kDepthFs = R"(#version 330 core
+void main() {}
 )";
 
 // A run of triangles of one mesh (a range of its index buffer) and their bounding box.
@@ -154,7 +137,7 @@ struct GpuMaterial {
 
 struct Target {
   int w = 0, h = 0, samples = 1;
-  GLuint ms_fbo = 0, ms_colour = 0, ms_depth = 0;  // textures: the resolve pass reads them
+  GLuint ms_fbo = 0, ms_colour = 0, ms_depth = 0;  // MSAA: renderbuffers, colour blitted to fbo
   GLuint fbo = 0, colour = 0, depth = 0;           // what is read back
   cv::Mat rgba;  // readback buffer, reused
 };
@@ -203,10 +186,10 @@ cv::Mat Frame::gray() const {
 
 struct Renderer::Impl {
   GlFunctions gl;
-  GLuint program = 0, resolve_program = 0, empty_vao = 0, white = 0;
+  GLuint program = 0, depth_program = 0, white = 0;
   GLint u_model_view = -1, u_proj = -1, u_model_rot = -1, u_tex = -1, u_to_light = -1,
         u_ambient = -1, u_diffuse = -1, u_unlit = -1;
-  GLint r_colour = -1, r_depth = -1, r_samples = -1;
+  GLint d_model_view = -1, d_proj = -1;
   std::vector<GpuMaterial> materials;
   std::vector<GpuMesh> static_meshes, lead_meshes;
   std::map<std::pair<int, int>, Target> targets;
@@ -348,6 +331,42 @@ struct Renderer::Impl {
                          static_cast<GLsizei>(draw_counts.size()));
   }
 
+  // The scene from view V: textured and lit (colour), or positions only (depth pass).
+  void draw_scene(bool colour, const Eigen::Matrix4f& P, const Eigen::Matrix4d& V,
+                  const std::optional<Eigen::Matrix4d>& lead_model) {
+    gl.UseProgram(colour ? program : depth_program);
+    gl.UniformMatrix4fv(colour ? u_proj : d_proj, 1, GL_FALSE, P.data());
+    if (colour) {
+      const Eigen::Vector3f to_light = (-info.light.direction.normalized()).cast<float>();
+      gl.Uniform3fv(u_to_light, 1, to_light.data());
+      gl.Uniform1f(u_ambient, static_cast<float>(info.light.ambient));
+      gl.Uniform1f(u_diffuse, static_cast<float>(info.light.diffuse));
+      gl.Uniform1i(u_tex, 0);
+      gl.ActiveTexture(GL_TEXTURE0);
+    }
+    draw_meshes(colour, static_meshes, P, V, Eigen::Matrix4d::Identity());
+    if (lead_model) draw_meshes(colour, lead_meshes, P, V, *lead_model);
+  }
+
+  void draw_meshes(bool colour, const std::vector<GpuMesh>& meshes, const Eigen::Matrix4f& P,
+                   const Eigen::Matrix4d& V, const Eigen::Matrix4d& M) {
+    const Eigen::Matrix4f MV = to_float(V * M);
+    const Eigen::Matrix4f clip_from_model = P * MV;
+    gl.UniformMatrix4fv(colour ? u_model_view : d_model_view, 1, GL_FALSE, MV.data());
+    if (colour) {
+      const Eigen::Matrix3f R = M.topLeftCorner<3, 3>().cast<float>();
+      gl.UniformMatrix3fv(u_model_rot, 1, GL_FALSE, R.data());
+    }
+    for (const auto& m : meshes) {
+      if (colour) {
+        const GpuMaterial* mat = m.material >= 0 ? &materials[m.material] : nullptr;
+        gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : white);
+        gl.Uniform1i(u_unlit, mat && mat->unlit ? 1 : 0);
+      }
+      draw_visible(m, clip_from_model);
+    }
+  }
+
   void check_fbo(const char* what) {
     const GLenum s = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
     if (s != GL_FRAMEBUFFER_COMPLETE)
@@ -364,40 +383,24 @@ struct Renderer::Impl {
     GLint max_samples = 1;
     gl.GetIntegerv(GL_MAX_SAMPLES, &max_samples);
     t.samples = std::max(1, std::min(info.msaa, static_cast<int>(max_samples)));
-    auto tex2d = [&](GLenum internal, GLenum format, GLenum type) {
+    auto renderbuffer = [&](int samples, GLenum internal, GLenum attachment) {
       GLuint x = 0;
-      gl.GenTextures(1, &x);
-      gl.BindTexture(GL_TEXTURE_2D, x);
-      gl.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), w, h, 0, format, type, nullptr);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      gl.GenRenderbuffers(1, &x);
+      gl.BindRenderbuffer(GL_RENDERBUFFER, x);
+      gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, internal, w, h);
+      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, x);
       return x;
     };
     gl.GenFramebuffers(1, &t.fbo);
     gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-    t.colour = tex2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.colour, 0);
-    gl.GenRenderbuffers(1, &t.depth);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
-    gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, w, h);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
-    check_fbo("resolve");
+    t.colour = renderbuffer(0, GL_RGBA8, GL_COLOR_ATTACHMENT0);
+    t.depth = renderbuffer(0, GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT);
+    check_fbo("single-sample");
     if (t.samples > 1) {
       gl.GenFramebuffers(1, &t.ms_fbo);
       gl.BindFramebuffer(GL_FRAMEBUFFER, t.ms_fbo);
-      auto texms = [&](GLenum internal) {
-        GLuint x = 0;
-        gl.GenTextures(1, &x);
-        gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, x);
-        gl.TexImage2DMultisample(GL_TEXTURE_2D_MULTISAMPLE, t.samples, internal, w, h, GL_TRUE);
-        return x;
-      };
-      t.ms_colour = texms(GL_RGBA8);
-      t.ms_depth = texms(GL_DEPTH_COMPONENT32F);
-      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D_MULTISAMPLE,
-                              t.ms_colour, 0);
-      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D_MULTISAMPLE,
-                              t.ms_depth, 0);
+      t.ms_colour = renderbuffer(t.samples, GL_RGBA8, GL_COLOR_ATTACHMENT0);
+      t.ms_depth = renderbuffer(t.samples, GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT);
       check_fbo("multisample");
     }
     t.rgba.create(h, w, CV_8UC4);
@@ -407,10 +410,9 @@ struct Renderer::Impl {
   void release() {
     for (auto& [k, t] : targets) {
       GLuint fbos[2] = {t.fbo, t.ms_fbo};
-      GLuint texs[3] = {t.colour, t.ms_colour, t.ms_depth};
+      GLuint rbs[4] = {t.colour, t.depth, t.ms_colour, t.ms_depth};
       gl.DeleteFramebuffers(2, fbos);
-      gl.DeleteTextures(3, texs);
-      gl.DeleteRenderbuffers(1, &t.depth);
+      gl.DeleteRenderbuffers(4, rbs);
     }
     for (auto* list : {&static_meshes, &lead_meshes})
       for (auto& m : *list) {
@@ -420,9 +422,8 @@ struct Renderer::Impl {
       }
     for (auto& m : materials) gl.DeleteTextures(1, &m.tex);
     gl.DeleteTextures(1, &white);
-    gl.DeleteVertexArrays(1, &empty_vao);
     gl.DeleteProgram(program);
-    gl.DeleteProgram(resolve_program);
+    gl.DeleteProgram(depth_program);
   }
 };
 
@@ -442,7 +443,7 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.info.msaa = scene.msaa;
   I.depth = depth_map(scene.near, scene.far, gl.ClipControl != nullptr);
   I.program = I.link(kSceneVs, kSceneFs);
-  I.resolve_program = I.link(kResolveVs, kResolveFs);
+  I.depth_program = I.link(kDepthVs, kDepthFs);
   I.u_model_view = gl.GetUniformLocation(I.program, "u_model_view");
   I.u_proj = gl.GetUniformLocation(I.program, "u_proj");
   I.u_model_rot = gl.GetUniformLocation(I.program, "u_model_rot");
@@ -451,10 +452,8 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.u_ambient = gl.GetUniformLocation(I.program, "u_ambient");
   I.u_diffuse = gl.GetUniformLocation(I.program, "u_diffuse");
   I.u_unlit = gl.GetUniformLocation(I.program, "u_unlit");
-  I.r_colour = gl.GetUniformLocation(I.resolve_program, "u_colour");
-  I.r_depth = gl.GetUniformLocation(I.resolve_program, "u_depth");
-  I.r_samples = gl.GetUniformLocation(I.resolve_program, "u_samples");
-  gl.GenVertexArrays(1, &I.empty_vao);
+  I.d_model_view = gl.GetUniformLocation(I.depth_program, "u_model_view");
+  I.d_proj = gl.GetUniformLocation(I.depth_program, "u_proj");
   I.white =
       I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, false, 1);
   for (const auto& m : scene.materials) {
@@ -510,64 +509,37 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
   V.topLeftCorner<3, 3>() = view.R_CW;
   V.topRightCorner<3, 1>() = -view.R_CW * view.x_c;
-
-  gl.BindFramebuffer(GL_FRAMEBUFFER, t.samples > 1 ? t.ms_fbo : t.fbo);
-  gl.Viewport(0, 0, w, h);
-  if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-  gl.Enable(GL_DEPTH_TEST);
-  gl.DepthFunc(I.depth.reversed ? GL_GREATER : GL_LESS);
-  gl.Disable(GL_CULL_FACE);  // the y-flipped projection mirrors the winding; draw both faces
-  if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
-  const float sky[4] = {static_cast<float>(I.info.sky.x()), static_cast<float>(I.info.sky.y()),
-                        static_cast<float>(I.info.sky.z()), 1.f};
-  gl.ClearBufferfv(GL_COLOR, 0, sky);
-  gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
-
-  gl.UseProgram(I.program);
-  gl.UniformMatrix4fv(I.u_proj, 1, GL_FALSE, P.data());
-  const Eigen::Vector3f to_light = (-I.info.light.direction.normalized()).cast<float>();
-  gl.Uniform3fv(I.u_to_light, 1, to_light.data());
-  gl.Uniform1f(I.u_ambient, static_cast<float>(I.info.light.ambient));
-  gl.Uniform1f(I.u_diffuse, static_cast<float>(I.info.light.diffuse));
-  gl.Uniform1i(I.u_tex, 0);
-  gl.ActiveTexture(GL_TEXTURE0);
-
-  auto draw = [&](const std::vector<GpuMesh>& meshes, const Eigen::Matrix4d& M) {
-    const Eigen::Matrix4f MV = to_float(V * M);
-    const Eigen::Matrix3f R = M.topLeftCorner<3, 3>().cast<float>();
-    const Eigen::Matrix4f clip_from_model = P * MV;
-    gl.UniformMatrix4fv(I.u_model_view, 1, GL_FALSE, MV.data());
-    gl.UniformMatrix3fv(I.u_model_rot, 1, GL_FALSE, R.data());
-    for (const auto& m : meshes) {
-      const GpuMaterial* mat = m.material >= 0 ? &I.materials[m.material] : nullptr;
-      gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : I.white);
-      gl.Uniform1i(I.u_unlit, mat && mat->unlit ? 1 : 0);
-      I.draw_visible(m, clip_from_model);
-    }
-  };
-  draw(I.static_meshes, Eigen::Matrix4d::Identity());
+  std::optional<Eigen::Matrix4d> lead_model;
   if (lead && !I.lead_meshes.empty()) {
     Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
     const double c = std::cos(lead->yaw), s = std::sin(lead->yaw);
     M.topLeftCorner<3, 3>() << c, -s, 0, s, c, 0, 0, 0, 1;
     M.topRightCorner<3, 1>() = lead->position;
-    draw(I.lead_meshes, M);
+    lead_model = M;
   }
 
+  gl.Viewport(0, 0, w, h);
+  if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(I.depth.reversed ? GL_GREATER : GL_LESS);
+  gl.Disable(GL_CULL_FACE);  // the y-flipped projection mirrors the winding; draw both faces
+  const float sky[4] = {static_cast<float>(I.info.sky.x()), static_cast<float>(I.info.sky.y()),
+                        static_cast<float>(I.info.sky.z()), 1.f};
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.samples > 1 ? t.ms_fbo : t.fbo);
+  if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
+  gl.ClearBufferfv(GL_COLOR, 0, sky);
+  gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
+  I.draw_scene(true, P, V, lead_model);
   if (t.samples > 1) {
+    // Colour: the samples averaged by the blit. Depth: a single-sample pass (kDepthVs).
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.ms_fbo);
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, t.fbo);
+    gl.BlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-    gl.DepthFunc(GL_ALWAYS);  // depth test on so that gl_FragDepth is written
-    gl.UseProgram(I.resolve_program);
-    gl.ActiveTexture(GL_TEXTURE0);
-    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_colour);
-    gl.ActiveTexture(GL_TEXTURE1);
-    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_depth);
-    gl.Uniform1i(I.r_colour, 0);
-    gl.Uniform1i(I.r_depth, 1);
-    gl.Uniform1i(I.r_samples, t.samples);
-    gl.BindVertexArray(I.empty_vao);
-    gl.DrawArrays(GL_TRIANGLES, 0, 3);
-    gl.ActiveTexture(GL_TEXTURE0);
+    gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
+    gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    I.draw_scene(false, P, V, lead_model);
+    gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   }
   gl.BindVertexArray(0);
 
