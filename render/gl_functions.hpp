@@ -34,7 +34,6 @@ namespace wingman::render {
   X(PFNGLTEXPARAMETERIPROC, TexParameteri) X(PFNGLTEXPARAMETERFPROC, TexParameterf)             \
   X(PFNGLGENERATEMIPMAPPROC, GenerateMipmap) X(PFNGLACTIVETEXTUREPROC, ActiveTexture)           \
   X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                                    \
-  X(PFNGLTEXIMAGE2DMULTISAMPLEPROC, TexImage2DMultisample)                                      \
   X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers) X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)     \
   X(PFNGLFRAMEBUFFERTEXTURE2DPROC, FramebufferTexture2D)                                        \
   X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, FramebufferRenderbuffer)                                  \
@@ -45,14 +44,20 @@ namespace wingman::render {
   X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers) X(PFNGLDRAWBUFFERSPROC, DrawBuffers)     \
   X(PFNGLREADBUFFERPROC, ReadBuffer) X(PFNGLREADPIXELSPROC, ReadPixels)                         \
   X(PFNGLPIXELSTOREIPROC, PixelStorei) X(PFNGLDRAWARRAYSPROC, DrawArrays)                       \
-  X(PFNGLDRAWELEMENTSPROC, DrawElements) X(PFNGLFINISHPROC, Finish)
+  X(PFNGLDRAWELEMENTSPROC, DrawElements) X(PFNGLFINISHPROC, Finish)                             \
+  X(PFNGLMULTIDRAWELEMENTSPROC, MultiDrawElements) X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)   \
+  X(PFNGLCOLORMASKPROC, ColorMask)
 
 struct GlFunctions {
 #define WINGMAN_GL_DECLARE(type, name) type name = nullptr;
   WINGMAN_GL_FUNCTIONS(WINGMAN_GL_DECLARE)
 #undef WINGMAN_GL_DECLARE
-  // Resolves every entry point; throws GlContextError naming the first one missing.
+  // Optional: GL 4.5 or ARB_clip_control (reversed-Z depth); null where the context lacks it.
+  PFNGLCLIPCONTROLPROC ClipControl = nullptr;
+  // Resolves every entry point; throws GlContextError naming the first one missing. The context
+  // must be current (the optional ones depend on its version and extensions).
   void load(const GlContext& ctx);
+  bool has_version_or_extension(int major, int minor, const char* extension) const;
 };
 
 }  // namespace wingman::render

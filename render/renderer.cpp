@@ -1,8 +1,10 @@
 #include "render/renderer.hpp"
 
+#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -13,6 +15,10 @@ namespace wingman::render {
 
 namespace {
 
+// Lambert shading per vertex: the terrain's normals vary smoothly over its 2 m cells and the
+// objects are flat-shaded, so per-pixel lighting changed nothing visible, while llvmpipe's
+// fragment cost grows with every varying and instruction. The fragment shader is one texture
+// lookup times one colour.
 const char* kSceneVs = R"(#version 330 core
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
@@ -21,70 +27,108 @@ layout(location = 3) in vec3 a_colour;
 uniform mat4 u_model_view;
 uniform mat4 u_proj;
 uniform mat3 u_model_rot;
-out vec3 v_normal;
+uniform vec3 u_to_light;
+uniform float u_ambient;
+uniform float u_diffuse;
+uniform bool u_unlit;
 out vec2 v_uv;
 out vec3 v_colour;
-out float v_depth;
 void main() {
-  vec4 pc = u_model_view * vec4(a_pos, 1.0);
-  v_depth = pc.z;
-  v_normal = u_model_rot * a_normal;
+  float shade = u_unlit ? 1.0
+      : u_ambient + u_diffuse * max(dot(normalize(u_model_rot * a_normal), u_to_light), 0.0);
   v_uv = a_uv;
-  v_colour = a_colour;
-  gl_Position = u_proj * pc;
+  v_colour = a_colour * shade;
+  gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
 }
 )";
 
 const char* kSceneFs = R"(#version 330 core
-in vec3 v_normal;
 in vec2 v_uv;
 in vec3 v_colour;
-in float v_depth;
 uniform sampler2D u_tex;
-uniform vec3 u_to_light;
-uniform float u_ambient;
-uniform float u_diffuse;
-uniform int u_unlit;
 layout(location = 0) out vec4 o_colour;
-layout(location = 1) out float o_depth;
 void main() {
-  vec3 albedo = texture(u_tex, v_uv).rgb * v_colour;
-  float shade = u_unlit != 0 ? 1.0
-      : u_ambient + u_diffuse * max(dot(normalize(v_normal), u_to_light), 0.0);
-  o_colour = vec4(albedo * shade, 1.0);
-  o_depth = v_depth;
+  o_colour = vec4(texture(u_tex, v_uv).rgb * v_colour, 1.0);
 }
 )";
 
-// MSAA resolve: colour averaged over the samples; depth from sample 0, which the fragment shader
-// evaluated at the pixel centre (no per-sample shading), so depth never blends two surfaces.
-const char* kResolveVs = R"(#version 330 core
+// With MSAA, depth comes from a second, single-sample pass of the same geometry with this
+// program (no colour, no texture): the surface at the pixel centre, exactly as without MSAA, never
+// a blend of two surfaces at an edge. Colour is resolved by glBlitFramebuffer. On llvmpipe this
+// costs 12 ms less than one resolve shader averaging the colour samples and picking a depth.
+const char* kDepthVs = R"(#version 330 core
+layout(location = 0) in vec3 a_pos;
+uniform mat4 u_model_view;
+uniform mat4 u_proj;
 void main() {
-  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+  gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
 }
 )";
 
-const char* kResolveFs = R"(#version 330 core
-uniform sampler2DMS u_colour;
-uniform sampler2DMS u_depth;
-uniform int u_samples;
-layout(location = 0) out vec4 o_colour;
-layout(location = 1) out float o_depth;
-void main() {
-  ivec2 p = ivec2(gl_FragCoord.xy);
-  vec4 c = vec4(0.0);
-  for (int i = 0; i < u_samples; ++i) c += texelFetch(u_colour, p, i);
-  o_colour = c / float(u_samples);
-  o_depth = texelFetch(u_depth, p, 0).r;
-}
+const char* kDepthFs = R"(#version 330 core
+void main() {}
 )";
+
+// A run of triangles of one mesh (a range of its index buffer) and their bounding box.
+struct Chunk {
+  Eigen::AlignedBox3f box;
+  GLsizei count = 0;
+  std::size_t first = 0;  // index of its first index
+};
 
 struct GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
-  GLsizei count = 0;
   int material = -1;
+  std::vector<Chunk> chunks;
 };
+
+// Static meshes are cut into square cells of this many metres (by triangle centroid, world x/y)
+// so that a frame draws only the cells in view: the terrain and the objects cover the whole
+// flight plus its margin, a camera sees about a tenth of that, and llvmpipe transforms, clips and
+// bins every vertex it is given on the application's thread, before rasterising starts.
+constexpr double kChunkSize = 16;
+
+// The mesh's triangle indices reordered cell by cell, and the cells.
+std::vector<Chunk> chunk_triangles(const Mesh& m, double cell, std::vector<std::uint32_t>& out) {
+  std::map<std::pair<long, long>, std::vector<std::uint32_t>> cells;
+  for (std::size_t i = 0; i + 2 < m.indices.size(); i += 3) {
+    Eigen::Vector3f c = Eigen::Vector3f::Zero();
+    for (int k = 0; k < 3; ++k) c += Eigen::Map<const Eigen::Vector3f>(&m.positions[3 * m.indices[i + k]]);
+    c /= 3;
+    auto& tris = cells[{std::lround(std::floor(c.x() / cell)), std::lround(std::floor(c.y() / cell))}];
+    tris.insert(tris.end(), m.indices.begin() + i, m.indices.begin() + i + 3);
+  }
+  std::vector<Chunk> chunks;
+  out.clear();
+  for (const auto& [key, tris] : cells) {
+    Chunk ch;
+    ch.first = out.size();
+    ch.count = static_cast<GLsizei>(tris.size());
+    for (auto v : tris) ch.box.extend(Eigen::Map<const Eigen::Vector3f>(&m.positions[3 * v]));
+    out.insert(out.end(), tris.begin(), tris.end());
+    chunks.push_back(ch);
+  }
+  return chunks;
+}
+
+// Whether any of the box can be in front of the camera and inside the image (clip = PV x):
+// false only when all eight corners are beyond one side of the view frustum.
+bool in_view(const Eigen::AlignedBox3f& box, const Eigen::Matrix4f& clip_from_world) {
+  int outside[5] = {0, 0, 0, 0, 0};
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3f p = box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(i));
+    const Eigen::Vector4f c = clip_from_world * p.homogeneous();
+    const float w = 1.001f * c.w();  // a little slack against rounding at the image border
+    outside[0] += c.x() < -w;
+    outside[1] += c.x() > w;
+    outside[2] += c.y() < -w;
+    outside[3] += c.y() > w;
+    outside[4] += c.w() <= 0;  // behind the camera (clip w = camera z)
+  }
+  for (int n : outside)
+    if (n == 8) return false;
+  return true;
+}
 
 struct GpuMaterial {
   GLuint tex = 0;
@@ -93,10 +137,42 @@ struct GpuMaterial {
 
 struct Target {
   int w = 0, h = 0, samples = 1;
-  GLuint ms_fbo = 0, ms_colour = 0, ms_depthval = 0, ms_depth = 0;
-  GLuint fbo = 0, colour = 0, depthval = 0, depth = 0;
-  cv::Mat rgba;  // readback buffers, reused
+  GLuint ms_fbo = 0, ms_colour = 0, ms_depth = 0;  // MSAA: renderbuffers, colour blitted to fbo
+  GLuint fbo = 0, colour = 0, depth = 0;           // what is read back
+  cv::Mat rgba;  // readback buffer, reused
 };
+
+// Window depth d = alpha + beta / z of the camera-frame depth z, exactly as the rasteriser
+// interpolates it (1/z is affine in screen space); read back, z = beta / (d - alpha). Reversed-Z
+// (near at 1, far at 0, with glClipControl's [0, 1] depth range) keeps float's relative precision
+// at every distance (worst 6 um at 20 m on llvmpipe); without clip control the classic mapping
+// (d crowding towards 1) is used: 2.7 mm at 20 m, 0.2 m at 400 m. `clear`: where nothing was drawn.
+struct DepthMap {
+  bool reversed = false;
+  double alpha = 0, beta = 0;
+  float clear = 1;
+};
+
+DepthMap depth_map(double n, double f, bool reversed) {
+  if (reversed) return {true, -n / (f - n), n * f / (f - n), 0.f};
+  return {false, f / (f - n), -n * f / (f - n), 1.f};
+}
+
+// Window depth to metres along the optical axis, in place; 0 where nothing was drawn. Float and
+// branch-free so that it vectorises: in double it took 1.3 ms a megapixel, on the thread that
+// waits for the frame. d - alpha is formed as (d - clear) - (alpha - clear): exact for d near
+// the clear value, where the classic mapping's alpha (1.0001) rounded to float would cost mm.
+void to_metric_depth(cv::Mat& d, const DepthMap& m) {
+  const float clear = m.clear, rest = static_cast<float>(m.alpha - m.clear),
+              beta = static_cast<float>(m.beta);
+  for (int r = 0; r < d.rows; ++r) {
+    float* p = d.ptr<float>(r);
+    for (int c = 0; c < d.cols; ++c) {
+      const float z = beta / ((p[c] - clear) - rest);  // never 0 / 0: alpha lies outside [0, 1]
+      p[c] = p[c] != clear ? z : 0.f;  // a select, not a branch around the division
+    }
+  }
+}
 
 Eigen::Matrix4f to_float(const Eigen::Matrix4d& m) { return m.cast<float>(); }
 
@@ -110,15 +186,18 @@ cv::Mat Frame::gray() const {
 
 struct Renderer::Impl {
   GlFunctions gl;
-  GLuint program = 0, resolve_program = 0, empty_vao = 0, white = 0;
+  GLuint program = 0, depth_program = 0, white = 0;
   GLint u_model_view = -1, u_proj = -1, u_model_rot = -1, u_tex = -1, u_to_light = -1,
         u_ambient = -1, u_diffuse = -1, u_unlit = -1;
-  GLint r_colour = -1, r_depth = -1, r_samples = -1;
+  GLint d_model_view = -1, d_proj = -1;
   std::vector<GpuMaterial> materials;
   std::vector<GpuMesh> static_meshes, lead_meshes;
   std::map<std::pair<int, int>, Target> targets;
+  std::vector<GLsizei> draw_counts;  // per-frame draw ranges, kept to avoid reallocating
+  std::vector<const void*> draw_offsets;
   Scene info;  // light, sky, near, far, msaa (meshes cleared)
   float max_aniso = 1;
+  DepthMap depth;  // reversed-Z where the context has glClipControl
 
   GLuint compile(GLenum type, const char* src) {
     GLuint s = gl.CreateShader(type);
@@ -151,7 +230,8 @@ struct Renderer::Impl {
     return p;
   }
 
-  GLuint upload_texture(const cv::Mat& img, bool repeat, bool mipmaps, double anisotropy) {
+  GLuint upload_texture(const cv::Mat& img, bool repeat, bool mipmaps, bool trilinear,
+                        double anisotropy) {
     cv::Mat rgba;
     if (img.channels() == 3)
       cv::cvtColor(img, rgba, cv::COLOR_RGB2RGBA);
@@ -172,7 +252,8 @@ struct Renderer::Impl {
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     if (mipmaps) {
       gl.GenerateMipmap(GL_TEXTURE_2D);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
+                       trilinear ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_NEAREST);
       if (max_aniso > 1 && anisotropy > 1)
         gl.TexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY,
                          std::min<float>(max_aniso, static_cast<float>(anisotropy)));
@@ -182,10 +263,20 @@ struct Renderer::Impl {
     return t;
   }
 
-  GpuMesh upload_mesh(const Mesh& m) {
+  // cell: chunk size in metres; 0 for one chunk (the lead, which moves).
+  GpuMesh upload_mesh(const Mesh& m, double cell) {
     GpuMesh g;
     g.material = m.material;
-    g.count = static_cast<GLsizei>(m.indices.size());
+    std::vector<std::uint32_t> indices;
+    if (cell > 0) {
+      g.chunks = chunk_triangles(m, cell, indices);
+    } else {
+      indices = m.indices;
+      Chunk all;
+      all.count = static_cast<GLsizei>(indices.size());
+      for (auto v : indices) all.box.extend(Eigen::Map<const Eigen::Vector3f>(&m.positions[3 * v]));
+      g.chunks.push_back(all);
+    }
     const std::size_t n = m.vertex_count();
     std::vector<float> v;
     v.reserve(n * 11);
@@ -204,8 +295,8 @@ struct Renderer::Impl {
     gl.GenBuffers(1, &g.ebo);
     gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
     gl.BufferData(GL_ELEMENT_ARRAY_BUFFER,
-                  static_cast<GLsizeiptr>(m.indices.size() * sizeof(std::uint32_t)),
-                  m.indices.data(), GL_STATIC_DRAW);
+                  static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)), indices.data(),
+                  GL_STATIC_DRAW);
     const GLsizei stride = 11 * sizeof(float);
     const int sizes[4] = {3, 3, 2, 3};
     std::size_t off = 0;
@@ -217,6 +308,63 @@ struct Renderer::Impl {
     }
     gl.BindVertexArray(0);
     return g;
+  }
+
+  // The mesh's chunks in view, adjacent ones merged, in one call.
+  void draw_visible(const GpuMesh& m, const Eigen::Matrix4f& clip_from_model) {
+    draw_counts.clear();
+    draw_offsets.clear();
+    std::size_t end = 0;
+    for (const Chunk& c : m.chunks) {
+      if (!in_view(c.box, clip_from_model)) continue;
+      if (!draw_counts.empty() && c.first == end) {
+        draw_counts.back() += c.count;
+      } else {
+        draw_counts.push_back(c.count);
+        draw_offsets.push_back(reinterpret_cast<const void*>(c.first * sizeof(std::uint32_t)));
+      }
+      end = c.first + static_cast<std::size_t>(c.count);
+    }
+    if (draw_counts.empty()) return;
+    gl.BindVertexArray(m.vao);
+    gl.MultiDrawElements(GL_TRIANGLES, draw_counts.data(), GL_UNSIGNED_INT, draw_offsets.data(),
+                         static_cast<GLsizei>(draw_counts.size()));
+  }
+
+  // The scene from view V: textured and lit (colour), or positions only (depth pass).
+  void draw_scene(bool colour, const Eigen::Matrix4f& P, const Eigen::Matrix4d& V,
+                  const std::optional<Eigen::Matrix4d>& lead_model) {
+    gl.UseProgram(colour ? program : depth_program);
+    gl.UniformMatrix4fv(colour ? u_proj : d_proj, 1, GL_FALSE, P.data());
+    if (colour) {
+      const Eigen::Vector3f to_light = (-info.light.direction.normalized()).cast<float>();
+      gl.Uniform3fv(u_to_light, 1, to_light.data());
+      gl.Uniform1f(u_ambient, static_cast<float>(info.light.ambient));
+      gl.Uniform1f(u_diffuse, static_cast<float>(info.light.diffuse));
+      gl.Uniform1i(u_tex, 0);
+      gl.ActiveTexture(GL_TEXTURE0);
+    }
+    draw_meshes(colour, static_meshes, P, V, Eigen::Matrix4d::Identity());
+    if (lead_model) draw_meshes(colour, lead_meshes, P, V, *lead_model);
+  }
+
+  void draw_meshes(bool colour, const std::vector<GpuMesh>& meshes, const Eigen::Matrix4f& P,
+                   const Eigen::Matrix4d& V, const Eigen::Matrix4d& M) {
+    const Eigen::Matrix4f MV = to_float(V * M);
+    const Eigen::Matrix4f clip_from_model = P * MV;
+    gl.UniformMatrix4fv(colour ? u_model_view : d_model_view, 1, GL_FALSE, MV.data());
+    if (colour) {
+      const Eigen::Matrix3f R = M.topLeftCorner<3, 3>().cast<float>();
+      gl.UniformMatrix3fv(u_model_rot, 1, GL_FALSE, R.data());
+    }
+    for (const auto& m : meshes) {
+      if (colour) {
+        const GpuMaterial* mat = m.material >= 0 ? &materials[m.material] : nullptr;
+        gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : white);
+        gl.Uniform1i(u_unlit, mat && mat->unlit ? 1 : 0);
+      }
+      draw_visible(m, clip_from_model);
+    }
   }
 
   void check_fbo(const char* what) {
@@ -235,51 +383,24 @@ struct Renderer::Impl {
     GLint max_samples = 1;
     gl.GetIntegerv(GL_MAX_SAMPLES, &max_samples);
     t.samples = std::max(1, std::min(info.msaa, static_cast<int>(max_samples)));
-    auto tex2d = [&](GLenum internal, GLenum format, GLenum type) {
+    auto renderbuffer = [&](int samples, GLenum internal, GLenum attachment) {
       GLuint x = 0;
-      gl.GenTextures(1, &x);
-      gl.BindTexture(GL_TEXTURE_2D, x);
-      gl.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal), w, h, 0, format, type, nullptr);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      gl.GenRenderbuffers(1, &x);
+      gl.BindRenderbuffer(GL_RENDERBUFFER, x);
+      gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, internal, w, h);
+      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, x);
       return x;
     };
-    const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     gl.GenFramebuffers(1, &t.fbo);
     gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-    t.colour = tex2d(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE);
-    t.depthval = tex2d(GL_R32F, GL_RED, GL_FLOAT);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.colour, 0);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, t.depthval, 0);
-    if (t.samples == 1) {
-      gl.GenRenderbuffers(1, &t.depth);
-      gl.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
-      gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, GL_DEPTH_COMPONENT32F, w, h);
-      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
-    }
-    gl.DrawBuffers(2, bufs);
-    check_fbo("resolve");
+    t.colour = renderbuffer(0, GL_RGBA8, GL_COLOR_ATTACHMENT0);
+    t.depth = renderbuffer(0, GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT);
+    check_fbo("single-sample");
     if (t.samples > 1) {
       gl.GenFramebuffers(1, &t.ms_fbo);
       gl.BindFramebuffer(GL_FRAMEBUFFER, t.ms_fbo);
-      auto texms = [&](GLenum internal) {
-        GLuint x = 0;
-        gl.GenTextures(1, &x);
-        gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, x);
-        gl.TexImage2DMultisample(GL_TEXTURE_2D_MULTISAMPLE, t.samples, internal, w, h, GL_TRUE);
-        return x;
-      };
-      t.ms_colour = texms(GL_RGBA8);
-      t.ms_depthval = texms(GL_R32F);
-      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D_MULTISAMPLE,
-                              t.ms_colour, 0);
-      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D_MULTISAMPLE,
-                              t.ms_depthval, 0);
-      gl.GenRenderbuffers(1, &t.ms_depth);
-      gl.BindRenderbuffer(GL_RENDERBUFFER, t.ms_depth);
-      gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, t.samples, GL_DEPTH_COMPONENT32F, w, h);
-      gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.ms_depth);
-      gl.DrawBuffers(2, bufs);
+      t.ms_colour = renderbuffer(t.samples, GL_RGBA8, GL_COLOR_ATTACHMENT0);
+      t.ms_depth = renderbuffer(t.samples, GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT);
       check_fbo("multisample");
     }
     t.rgba.create(h, w, CV_8UC4);
@@ -289,11 +410,9 @@ struct Renderer::Impl {
   void release() {
     for (auto& [k, t] : targets) {
       GLuint fbos[2] = {t.fbo, t.ms_fbo};
-      GLuint texs[4] = {t.colour, t.depthval, t.ms_colour, t.ms_depthval};
-      GLuint rbs[2] = {t.depth, t.ms_depth};
+      GLuint rbs[4] = {t.colour, t.depth, t.ms_colour, t.ms_depth};
       gl.DeleteFramebuffers(2, fbos);
-      gl.DeleteTextures(4, texs);
-      gl.DeleteRenderbuffers(2, rbs);
+      gl.DeleteRenderbuffers(4, rbs);
     }
     for (auto* list : {&static_meshes, &lead_meshes})
       for (auto& m : *list) {
@@ -303,9 +422,8 @@ struct Renderer::Impl {
       }
     for (auto& m : materials) gl.DeleteTextures(1, &m.tex);
     gl.DeleteTextures(1, &white);
-    gl.DeleteVertexArrays(1, &empty_vao);
     gl.DeleteProgram(program);
-    gl.DeleteProgram(resolve_program);
+    gl.DeleteProgram(depth_program);
   }
 };
 
@@ -323,8 +441,9 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.info.near = scene.near;
   I.info.far = scene.far;
   I.info.msaa = scene.msaa;
+  I.depth = depth_map(scene.near, scene.far, gl.ClipControl != nullptr);
   I.program = I.link(kSceneVs, kSceneFs);
-  I.resolve_program = I.link(kResolveVs, kResolveFs);
+  I.depth_program = I.link(kDepthVs, kDepthFs);
   I.u_model_view = gl.GetUniformLocation(I.program, "u_model_view");
   I.u_proj = gl.GetUniformLocation(I.program, "u_proj");
   I.u_model_rot = gl.GetUniformLocation(I.program, "u_model_rot");
@@ -333,21 +452,21 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.u_ambient = gl.GetUniformLocation(I.program, "u_ambient");
   I.u_diffuse = gl.GetUniformLocation(I.program, "u_diffuse");
   I.u_unlit = gl.GetUniformLocation(I.program, "u_unlit");
-  I.r_colour = gl.GetUniformLocation(I.resolve_program, "u_colour");
-  I.r_depth = gl.GetUniformLocation(I.resolve_program, "u_depth");
-  I.r_samples = gl.GetUniformLocation(I.resolve_program, "u_samples");
-  gl.GenVertexArrays(1, &I.empty_vao);
-  I.white = I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, 1);
+  I.d_model_view = gl.GetUniformLocation(I.depth_program, "u_model_view");
+  I.d_proj = gl.GetUniformLocation(I.depth_program, "u_proj");
+  I.white =
+      I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, false, 1);
   for (const auto& m : scene.materials) {
     GpuMaterial g;
-    g.tex = m.texture.empty() ? 0 : I.upload_texture(m.texture, m.repeat, m.mipmaps, m.anisotropy);
+    g.tex = m.texture.empty() ? 0 : I.upload_texture(m.texture, m.repeat, m.mipmaps, m.trilinear,
+                                                         m.anisotropy);
     g.unlit = m.unlit;
     I.materials.push_back(g);
   }
   for (const auto& m : scene.static_meshes)
-    if (!m.indices.empty()) I.static_meshes.push_back(I.upload_mesh(m));
+    if (!m.indices.empty()) I.static_meshes.push_back(I.upload_mesh(m, kChunkSize));
   for (const auto& m : scene.lead_meshes)
-    if (!m.indices.empty()) I.lead_meshes.push_back(I.upload_mesh(m));
+    if (!m.indices.empty()) I.lead_meshes.push_back(I.upload_mesh(m, 0));
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
     throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while uploading the scene");
 }
@@ -362,7 +481,7 @@ Renderer::~Renderer() {
 }
 
 Eigen::Matrix4d Renderer::projection(double fx, double fy, double cx, double cy, int w, int h,
-                                     double n, double f) {
+                                     double n, double f, bool reversed_z) {
   // Clip w = z (OpenCV camera looks along +z). Window x = u + 0.5 puts u = fx x/z + cx at the
   // centre of pixel column u; window y = v + 0.5 makes GL's row 0 the image's top row.
   Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
@@ -370,8 +489,11 @@ Eigen::Matrix4d Renderer::projection(double fx, double fy, double cx, double cy,
   P(0, 2) = 2 * (cx + 0.5) / w - 1;
   P(1, 1) = 2 * fy / h;
   P(1, 2) = 2 * (cy + 0.5) / h - 1;
-  P(2, 2) = (f + n) / (f - n);
-  P(2, 3) = -2 * f * n / (f - n);
+  // Clip z = a z + b: NDC z runs from -1 at near to 1 at far, or (reversed, for a [0, 1] clip
+  // range) from 1 at near to 0 at far; see DepthMap.
+  const DepthMap m = depth_map(n, f, reversed_z);
+  P(2, 2) = reversed_z ? m.alpha : (f + n) / (f - n);
+  P(2, 3) = reversed_z ? m.beta : -2 * f * n / (f - n);
   P(3, 2) = 1;
   return P;
 }
@@ -382,70 +504,42 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   Impl& I = *impl_;
   auto& gl = I.gl;
   Target& t = I.target(w, h);
-  const Eigen::Matrix4f P = to_float(projection(fx, fy, cx, cy, w, h, I.info.near, I.info.far));
+  const Eigen::Matrix4f P =
+      to_float(projection(fx, fy, cx, cy, w, h, I.info.near, I.info.far, I.depth.reversed));
   Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
   V.topLeftCorner<3, 3>() = view.R_CW;
   V.topRightCorner<3, 1>() = -view.R_CW * view.x_c;
-
-  gl.BindFramebuffer(GL_FRAMEBUFFER, t.samples > 1 ? t.ms_fbo : t.fbo);
-  gl.Viewport(0, 0, w, h);
-  gl.Enable(GL_DEPTH_TEST);
-  gl.DepthFunc(GL_LESS);
-  gl.Disable(GL_CULL_FACE);  // the y-flipped projection mirrors the winding; draw both faces
-  if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
-  const float sky[4] = {static_cast<float>(I.info.sky.x()), static_cast<float>(I.info.sky.y()),
-                        static_cast<float>(I.info.sky.z()), 1.f};
-  const float zero[4] = {0, 0, 0, 0};
-  const float one = 1.f;
-  gl.ClearBufferfv(GL_COLOR, 0, sky);
-  gl.ClearBufferfv(GL_COLOR, 1, zero);
-  gl.ClearBufferfv(GL_DEPTH, 0, &one);
-
-  gl.UseProgram(I.program);
-  gl.UniformMatrix4fv(I.u_proj, 1, GL_FALSE, P.data());
-  const Eigen::Vector3f to_light = (-I.info.light.direction.normalized()).cast<float>();
-  gl.Uniform3fv(I.u_to_light, 1, to_light.data());
-  gl.Uniform1f(I.u_ambient, static_cast<float>(I.info.light.ambient));
-  gl.Uniform1f(I.u_diffuse, static_cast<float>(I.info.light.diffuse));
-  gl.Uniform1i(I.u_tex, 0);
-  gl.ActiveTexture(GL_TEXTURE0);
-
-  auto draw = [&](const std::vector<GpuMesh>& meshes, const Eigen::Matrix4d& M) {
-    const Eigen::Matrix4f MV = to_float(V * M);
-    const Eigen::Matrix3f R = M.topLeftCorner<3, 3>().cast<float>();
-    gl.UniformMatrix4fv(I.u_model_view, 1, GL_FALSE, MV.data());
-    gl.UniformMatrix3fv(I.u_model_rot, 1, GL_FALSE, R.data());
-    for (const auto& m : meshes) {
-      const GpuMaterial* mat = m.material >= 0 ? &I.materials[m.material] : nullptr;
-      gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : I.white);
-      gl.Uniform1i(I.u_unlit, mat && mat->unlit ? 1 : 0);
-      gl.BindVertexArray(m.vao);
-      gl.DrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
-    }
-  };
-  draw(I.static_meshes, Eigen::Matrix4d::Identity());
+  std::optional<Eigen::Matrix4d> lead_model;
   if (lead && !I.lead_meshes.empty()) {
     Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
     const double c = std::cos(lead->yaw), s = std::sin(lead->yaw);
     M.topLeftCorner<3, 3>() << c, -s, 0, s, c, 0, 0, 0, 1;
     M.topRightCorner<3, 1>() = lead->position;
-    draw(I.lead_meshes, M);
+    lead_model = M;
   }
 
+  gl.Viewport(0, 0, w, h);
+  if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(I.depth.reversed ? GL_GREATER : GL_LESS);
+  gl.Disable(GL_CULL_FACE);  // the y-flipped projection mirrors the winding; draw both faces
+  const float sky[4] = {static_cast<float>(I.info.sky.x()), static_cast<float>(I.info.sky.y()),
+                        static_cast<float>(I.info.sky.z()), 1.f};
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.samples > 1 ? t.ms_fbo : t.fbo);
+  if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
+  gl.ClearBufferfv(GL_COLOR, 0, sky);
+  gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
+  I.draw_scene(true, P, V, lead_model);
   if (t.samples > 1) {
+    // Colour: the samples averaged by the blit. Depth: a single-sample pass (kDepthVs).
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.ms_fbo);
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, t.fbo);
+    gl.BlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-    gl.Disable(GL_DEPTH_TEST);
-    gl.UseProgram(I.resolve_program);
-    gl.ActiveTexture(GL_TEXTURE0);
-    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_colour);
-    gl.ActiveTexture(GL_TEXTURE1);
-    gl.BindTexture(GL_TEXTURE_2D_MULTISAMPLE, t.ms_depthval);
-    gl.Uniform1i(I.r_colour, 0);
-    gl.Uniform1i(I.r_depth, 1);
-    gl.Uniform1i(I.r_samples, t.samples);
-    gl.BindVertexArray(I.empty_vao);
-    gl.DrawArrays(GL_TRIANGLES, 0, 3);
-    gl.ActiveTexture(GL_TEXTURE0);
+    gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
+    gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    I.draw_scene(false, P, V, lead_model);
+    gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   }
   gl.BindVertexArray(0);
 
@@ -455,9 +549,9 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
   gl.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, t.rgba.data);
-  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-  gl.ReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, f.depth.data);
+  gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, f.depth.data);
   cv::cvtColor(t.rgba, f.rgb, cv::COLOR_RGBA2RGB);
+  to_metric_depth(f.depth, I.depth);
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
     throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while rendering");
   return f;

@@ -1,5 +1,6 @@
 // The off-screen renderer: draws a Scene from any number of pinhole cameras and reads back
-// colour (RGB8) and metric depth (float metres along the optical axis, 0 where nothing was hit).
+// colour (RGB8) and metric depth (float metres along the optical axis, 0 where nothing was hit,
+// converted from the hardware depth buffer).
 // Pixels obey DESIGN.md §2 exactly: the projection puts u = fx x/z + cx at the centre of pixel
 // column u (OpenCV's convention), and GL's bottom row is rendered as image row 0, so readback
 // needs no flip. Radial-tangential distortion, when the camera has it, is applied by cv::remap
@@ -45,9 +46,10 @@ class Renderer {
   const GlContext& context() const { return ctx_; }
 
   // The OpenGL projection matrix for an undistorted w x h image with these intrinsics
-  // (camera frame: OpenCV's; exposed for tests).
+  // (camera frame: OpenCV's; exposed for tests). reversed_z: near maps to NDC z 1 and far to 0,
+  // for glClipControl's [0, 1] depth range; otherwise GL's classic -1 to 1.
   static Eigen::Matrix4d projection(double fx, double fy, double cx, double cy, int w, int h,
-                                    double near, double far);
+                                    double near, double far, bool reversed_z = false);
 
  private:
   struct Impl;

@@ -450,6 +450,7 @@ Scene build_scene(const sim::Scenario& scn) {
 
   Material ground;
   ground.anisotropy = w.texture.anisotropy;
+  ground.trilinear = w.texture.filter == sim::TextureSpec::Filter::Trilinear;
   double tex_w = w.texture.tile_size, tex_h = w.texture.tile_size;
   if (w.texture.type == sim::TextureSpec::Type::Image) {
     const std::string p = resolve_asset(w.texture.image, scn.source_path, "ground texture");
@@ -469,6 +470,7 @@ Scene build_scene(const sim::Scenario& scn) {
     Material detail;
     detail.texture = detail_texture(scn.seed);
     detail.anisotropy = w.texture.anisotropy;
+    detail.trilinear = ground.trilinear;
     scene.materials.push_back(detail);
     scene.static_meshes.push_back(
         objects_mesh(objects, static_cast<int>(scene.materials.size()) - 1));

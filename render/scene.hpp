@@ -18,6 +18,7 @@ struct Material {
   bool repeat = true;
   bool mipmaps = true;
   double anisotropy = 4;
+  bool trilinear = true;  // between mipmap levels; false: the nearest level only (faster)
   bool unlit = false;  // colour shown as is (markers, test targets)
 };
 

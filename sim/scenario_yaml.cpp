@@ -752,7 +752,7 @@ void parse_world_terrain(const Ctx& ctx, const Field& f, TerrainSpec& t) {
 
 void parse_world_texture(const Ctx& ctx, const Field& f, TextureSpec& t) {
   MapView m(ctx, f, {"type", "image", "mode", "tile_size", "detail_min", "detail_max", "size",
-                     "anisotropy"});
+                     "anisotropy", "filter"});
   if (auto x = m.get("type"))
     t.type = read_enum<TextureSpec::Type>(
         ctx, *x, {{"image", TextureSpec::Type::Image}, {"procedural", TextureSpec::Type::Procedural}});
@@ -769,6 +769,9 @@ void parse_world_texture(const Ctx& ctx, const Field& f, TextureSpec& t) {
                          t.detail_min));
   set_if(m, "size", t.size, [&](const Field& x) { return read_int(ctx, x, 16, 8192); });
   num(ctx, m, "anisotropy", t.anisotropy, in(1, 64));
+  if (auto x = m.get("filter"))
+    t.filter = read_enum<TextureSpec::Filter>(
+        ctx, *x, {{"trilinear", TextureSpec::Filter::Trilinear}, {"bilinear", TextureSpec::Filter::Bilinear}});
 }
 
 void parse_world_objects(const Ctx& ctx, const Field& f, ObjectsSpec& o) {

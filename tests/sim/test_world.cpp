@@ -24,6 +24,7 @@ TEST(World, DefaultsWhenAbsent) {
   EXPECT_EQ(s.world.texture.type, TextureSpec::Type::Image);
   EXPECT_EQ(s.world.lead.cue, LeadModelSpec::Cue::Aruco);
   EXPECT_EQ(s.world.image.msaa, 4);
+  EXPECT_EQ(s.world.texture.filter, TextureSpec::Filter::Trilinear);
   EXPECT_NE(s.world.lead.model.find("CesiumMilkTruck"), std::string::npos);
 }
 
@@ -31,7 +32,8 @@ TEST(World, ParsesEverySection) {
   const Scenario s = parse_scenarios(R"(name: x
 world:
   terrain: {extent: 300, mean_height: 1, relief: 0.5, relief_scale: 30, resolution: 4}
-  texture: {type: procedural, detail_min: 0.03, detail_max: 0.15, size: 512, anisotropy: 8}
+  texture: {type: procedural, detail_min: 0.03, detail_max: 0.15, size: 512, anisotropy: 8,
+            filter: bilinear}
   objects: {boulders: 5, trees: 0, buildings: 1, clearance: 10}
   lead: {model: my/truck.obj, kind: aerial, height: 1.5, up: z, cue: panel, panel_colour: [0, 1, 1]}
   light: {direction: [0, 0, -1], ambient: 0.3, diffuse: 0.8}
@@ -44,6 +46,7 @@ world:
   EXPECT_EQ(w.terrain.resolution, 4);
   EXPECT_EQ(w.texture.type, TextureSpec::Type::Procedural);
   EXPECT_EQ(w.texture.size, 512);
+  EXPECT_EQ(w.texture.filter, TextureSpec::Filter::Bilinear);
   EXPECT_EQ(w.objects.trees, 0);
   EXPECT_EQ(w.lead.model, "my/truck.obj");
   EXPECT_EQ(w.lead.kind, LeadModelSpec::Kind::Aerial);
@@ -60,6 +63,9 @@ TEST(World, ErrorsNameFileLineAndKey) {
             "w.yaml:2:13: world.terrain.relif: unknown key 'relif' (did you mean 'relief'?)");
   EXPECT_NE(error_of("world:\n  texture: {mode: mirrored}\n")
                 .find("w.yaml:2:19: world.texture.mode: unknown value 'mirrored'"),
+            std::string::npos);
+  EXPECT_NE(error_of("world:\n  texture: {filter: nearest}\n")
+                .find("w.yaml:2:21: world.texture.filter: unknown value 'nearest'"),
             std::string::npos);
   EXPECT_NE(error_of("world:\n  image: {msaa: 3}\n").find("world.image.msaa: must be 1, 2, 4, 8 or 16"),
             std::string::npos);
