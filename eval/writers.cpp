@@ -221,7 +221,7 @@ void write_steps_csv(const RunRecord& run, const fs::path& path) {
   }
   fmt::format_to(out,
                  ",nees,landmarks,landmarks_visible,matches_offered,matches_accepted,initialised,"
-                 "t_predict_ms,t_update_ms,t_init_ms\n");
+                 "t_predict_ms,t_update_ms,t_init_ms,t_render_ms,t_detect_ms,t_match_ms\n");
   for (const StepRecord& s : run.steps) {
     fmt::format_to(out, "{},{},{}", s.k, s.t, s.phase);
     for (std::size_t a = 0; a < run.agent_names.size(); ++a) {
@@ -240,6 +240,9 @@ void write_steps_csv(const RunRecord& run, const fs::path& path) {
     put(b, s.t_predict_ms);
     put(b, s.t_update_ms);
     put(b, s.t_init_ms);
+    put(b, s.t_render_ms);
+    put(b, s.t_detect_ms);
+    put(b, s.t_match_ms);
     fmt::format_to(out, "\n");
   }
   write_file(path, fmt::to_string(b));

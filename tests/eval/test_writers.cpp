@@ -150,7 +150,7 @@ TEST(Writers, StepsCsvHeaderAndValues) {
   const std::vector<std::string> lines = read_lines(tmp.path() / "steps.csv");
   ASSERT_EQ(lines.size(), run.steps.size() + 1);
   const std::vector<std::string> header = split(lines[0], ',');
-  ASSERT_EQ(header.size(), 3u + 2u * 17u + 9u);
+  ASSERT_EQ(header.size(), 3u + 2u * 17u + 12u);
   EXPECT_EQ(header[0], "k");
   EXPECT_EQ(header[3], "lead_px_true");
   EXPECT_EQ(header[6], "lead_px_est");
@@ -158,7 +158,7 @@ TEST(Writers, StepsCsvHeaderAndValues) {
   EXPECT_EQ(header[15], "lead_sx");
   EXPECT_EQ(header[18], "lead_nees_p");
   EXPECT_EQ(header[20], "uav1_px_true");
-  EXPECT_EQ(header.back(), "t_init_ms");
+  EXPECT_EQ(header.back(), "t_match_ms");
 
   auto col = [&](const std::string& name) {
     const auto it = std::find(header.begin(), header.end(), name);
