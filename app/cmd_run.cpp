@@ -34,6 +34,7 @@ struct RunOptions {
   std::string gl = "auto";
   std::string video;
   bool no_plots = false;
+  bool no_prefetch = false;
   bool quiet = false;
 };
 
@@ -74,7 +75,9 @@ int run_command(const RunOptions& o) {
       }
       if (!video.empty() && scn.measurements != sim::MeasurementMode::Rendered)
         throw UsageError("--video needs a scenario with measurements: rendered");
-      rec = run_scenario(scn, RenderedOptions(gl, video),
+      RenderedOptions ro(gl, video);
+      ro.prefetch = !o.no_prefetch;
+      rec = run_scenario(scn, ro,
                          [&](int k, int n) { progress.update(k, n, "steps"); });
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());  // a world or frontend setting the scenario got wrong
@@ -126,6 +129,9 @@ Subcommand add_run(CLI::App& parent) {
                   "new matches, rejected correspondences and the lead detection (MJPG AVI; one "
                   "file per variant, FILE_<variant>.avi, when several run)");
   cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
+  cmd->add_flag("--no-prefetch", o->no_prefetch,
+                "Rendered, open loop: render each step's frames at that step, not during the "
+                "previous step's detection (same results, for timing comparisons)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return run_command(*o); }};
 }

@@ -107,6 +107,8 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   else if (scn.measurements == sim::MeasurementMode::Rendered)
     fe = std::make_unique<RenderedFrontend>(scn, cam_uav, ro.gl);
   if (fe && !ro.video.empty()) fe->open_video(ro.video);
+  // Open loop: step k+1's truth is known at step k, so its frames can render during step k.
+  if (fe) fe->set_prefetch(!scn.closed_loop() && ro.prefetch);
 
   std::vector<slam::CameraRig> rigs;
   std::vector<slam::AgentInit> cam_init;

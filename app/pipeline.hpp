@@ -35,6 +35,8 @@ struct RenderedOptions {
       : gl(backend), video(std::move(video_path)) {}
   render::GlBackend gl;
   std::string video;  // non-empty: both cameras side by side with what the frontend did, per step
+  // Open loop: render step k+1 while step k's detection runs (same results, less wall time).
+  bool prefetch = true;
 };
 eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& rendered = {},
                              const ProgressFn& progress = {}, const StateObserver& observer = {});

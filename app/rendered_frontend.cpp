@@ -140,31 +140,80 @@ std::string RenderedFrontend::renderer_description() const {
   return ctx_ ? ctx_->description() : std::string("dataset replay");
 }
 
+render::LeadPose RenderedFrontend::true_lead_pose(const sim::Truth& truth, double t) const {
+  render::LeadPose lead = render::lead_pose(scn_, t);
+  lead.position = truth.lead(t).position;
+  return lead;
+}
+
+void RenderedFrontend::render_camera(const sim::Truth& truth, int j, double t,
+                                     const render::LeadPose& lead, render::Frame& frame,
+                                     vision::CameraPose& pose) {
+  const int u = cam_uav_[j];
+  pose = {truth.camera_R_CW(u, t), truth.camera(u, t).position};
+  frame = renderer_->render({cams_[j].model, pose.R_CW, pose.position}, lead);
+  effects_[j]->apply(frame);
+}
+
 StageTimes RenderedFrontend::render_and_detect(const sim::Truth& truth, int k, double t,
                                                const slam::Estimator& est,
                                                eval::FrontendRecord& fr) {
   StageTimes st;
   const auto t_start = Clock::now();
-  render::LeadPose lead = render::lead_pose(scn_, t);
-  lead.position = truth.lead(t).position;
-  // Camera j's detection runs on a second thread while camera j+1 renders (the GL context stays
-  // on this thread; two detections never run at once, so the extractor is never shared).
-  std::future<double> pending;
-  for (std::size_t j = 0; j < cams_.size(); ++j) {
-    Cam& c = cams_[j];
-    const auto t0 = Clock::now();
-    c.true_pose = {truth.camera_R_CW(cam_uav_[j], t), truth.camera(cam_uav_[j], t).position};
-    if (frames_) {
-      c.frame = frames_(static_cast<int>(j), k);
-    } else {
-      c.frame = renderer_->render({c.model, c.true_pose.R_CW, c.true_pose.position}, lead);
-      effects_[j]->apply(c.frame);
+  const render::LeadPose lead = true_lead_pose(truth, t);
+  const int n = static_cast<int>(cams_.size());
+  const bool ahead = prefetch_ && k < scn_.num_steps();
+  const bool have = next_.k == k;  // rendered during the previous step
+  if (have) {
+    for (int j = 0; j < n; ++j) {
+      cams_[j].frame = std::move(next_.frames[j]);
+      cams_[j].true_pose = next_.poses[j];
     }
+    next_.k = -1;
+  } else if (ahead) {
+    const auto t0 = Clock::now();
+    for (int j = 0; j < n; ++j) render_camera(truth, j, t, lead, cams_[j].frame, cams_[j].true_pose);
     st.render_ms += ms_since(t0);
-    if (pending.valid()) st.detect_ms += pending.get();
-    pending = std::async(std::launch::async, [this, j, &est] { return detect_camera(static_cast<int>(j), est); });
   }
-  if (pending.valid()) st.detect_ms += pending.get();
+
+  if (have && !ahead) {  // the last step: nothing left to render
+    for (int j = 0; j < n; ++j) st.detect_ms += detect_camera(j, est);
+  } else if (ahead) {
+    // Step k's detection (both cameras, one after the other: the extractor is not shared) on a
+    // second thread while this one, which holds the GL context, renders step k+1.
+    auto detection = std::async(std::launch::async, [this, n, &est] {
+      double ms = 0;
+      for (int j = 0; j < n; ++j) ms += detect_camera(j, est);
+      return ms;
+    });
+    const auto t0 = Clock::now();
+    const double t1 = (k + 1) * scn_.dt();
+    const render::LeadPose lead1 = true_lead_pose(truth, t1);
+    next_.frames.resize(n);
+    next_.poses.resize(n);
+    for (int j = 0; j < n; ++j) render_camera(truth, j, t1, lead1, next_.frames[j], next_.poses[j]);
+    next_.k = k + 1;
+    st.render_ms += ms_since(t0);
+    st.detect_ms += detection.get();
+  } else {
+    // Camera j's detection runs on a second thread while camera j+1 renders (the GL context
+    // stays on this thread; two detections never run at once, so the extractor is never shared).
+    std::future<double> pending;
+    for (int j = 0; j < n; ++j) {
+      Cam& c = cams_[j];
+      const auto t0 = Clock::now();
+      if (frames_) {
+        c.true_pose = {truth.camera_R_CW(cam_uav_[j], t), truth.camera(cam_uav_[j], t).position};
+        c.frame = frames_(j, k);
+      } else {
+        render_camera(truth, j, t, lead, c.frame, c.true_pose);
+      }
+      st.render_ms += ms_since(t0);
+      if (pending.valid()) st.detect_ms += pending.get();
+      pending = std::async(std::launch::async, [this, j, &est] { return detect_camera(j, est); });
+    }
+    if (pending.valid()) st.detect_ms += pending.get();
+  }
   st.wall_ms = ms_since(t_start);
 
   // Tallies against the truth (evaluation only): in view when the reference point projects

@@ -85,8 +85,13 @@ class RenderedFrontend {
   // then per camera the lead detection (searched first around the estimate's projection) and
   // features outside the lead's box; updates the lead detector's tallies in `fr`. Camera j's
   // detection overlaps camera j+1's rendering, so the two times may add up to more than the wall.
+  // With prefetch on, step k's frames were rendered during step k-1, and step k+1's are rendered
+  // while step k's detection runs on a second thread.
   StageTimes render_and_detect(const sim::Truth& truth, int k, double t, const slam::Estimator& est,
                                eval::FrontendRecord& fr);
+  // Open loop only: the truth of step k+1 must be known at step k. Ignored on dataset replay.
+  // The frames, and so every result, are the same with it on or off; only the timing changes.
+  void set_prefetch(bool on) { prefetch_ = on && !frames_; }
   std::optional<Eigen::Vector2d> lead_pixel(int cam) const { return cams_[cam].lead; }
 
   // Tracking of the filter's predictions in camera `cam`, labelled against the truth.
@@ -118,6 +123,10 @@ class RenderedFrontend {
   // What both constructors set up: the cameras' models and the frontend's settings from scn_.
   void init_cameras();
   double detect_camera(int cam, const slam::Estimator& est);  // ms spent
+  // Camera j's true pose and rendered frame (image effects applied) at step k.
+  void render_camera(const sim::Truth& truth, int j, double t, const render::LeadPose& lead,
+                     render::Frame& frame, vision::CameraPose& pose);
+  render::LeadPose true_lead_pose(const sim::Truth& truth, double t) const;
   struct Cam {
     geometry::PinholeCamera model;
     render::Frame frame;
@@ -144,6 +153,12 @@ class RenderedFrontend {
   bool colour_lead_ = false;
   std::unique_ptr<cv::VideoWriter> video_;
   std::string video_path_;
+  bool prefetch_ = false;
+  struct Prefetched {
+    int k = -1;  // the step they belong to; -1: none
+    std::vector<render::Frame> frames;
+    std::vector<vision::CameraPose> poses;
+  } next_;
 };
 
 }  // namespace wingman::app

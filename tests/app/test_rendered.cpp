@@ -114,6 +114,36 @@ TEST(RenderedPipeline, SingleUavBaselineRunsOnQuadOnesFramesAlone) {
   EXPECT_GT(rec.outliers[0].correspondences, 0);
 }
 
+// Rendering step k+1 during step k's detection changes when frames are made, not what they are:
+// every figure but the timings is the same with it off.
+TEST(RenderedPipeline, PrefetchChangesTimingOnly) {
+  std::string why;
+  if (!gl_available(&why)) GTEST_SKIP() << why;
+  sim::Scenario s = variant("multi");
+  s.duration = 3;
+  RenderedOptions on, off;
+  off.prefetch = false;
+  const auto a = run_scenario(s, on), b = run_scenario(s, off);
+  ASSERT_EQ(a.steps.size(), b.steps.size());
+  for (std::size_t k = 0; k < a.steps.size(); ++k) {
+    ASSERT_EQ(a.steps[k].agents.size(), b.steps[k].agents.size());
+    for (std::size_t i = 0; i < a.steps[k].agents.size(); ++i) {
+      EXPECT_EQ(a.steps[k].agents[i].p_est, b.steps[k].agents[i].p_est) << "step " << k;
+      EXPECT_EQ(a.steps[k].agents[i].p_sigma, b.steps[k].agents[i].p_sigma) << "step " << k;
+    }
+    EXPECT_EQ(a.steps[k].matches_accepted, b.steps[k].matches_accepted) << "step " << k;
+  }
+  ASSERT_EQ(a.outliers.size(), b.outliers.size());
+  for (std::size_t c = 0; c < a.outliers.size(); ++c) {
+    EXPECT_EQ(a.outliers[c].correspondences, b.outliers[c].correspondences);
+    EXPECT_EQ(a.outliers[c].outliers, b.outliers[c].outliers);
+  }
+  EXPECT_EQ(a.frontend.lead_error_px, b.frontend.lead_error_px);
+  EXPECT_EQ(a.frontend.frames, b.frontend.frames);
+  EXPECT_GT(a.landmarks.size(), 0u);
+  EXPECT_EQ(a.landmarks.size(), b.landmarks.size());
+}
+
 TEST(RenderedPipeline, MissingLeadModelIsAnErrorNamingTheFile) {
   TempDir dir;
   std::string text = read_file(kRenderedSmoke);
