@@ -4,11 +4,13 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <thread>
 
 #include "app/rendered_frontend.hpp"
 #include "app/version.hpp"
@@ -102,13 +104,23 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   }
   const int ncam = static_cast<int>(cam_uav.size());
   std::unique_ptr<RenderedFrontend> fe;
+  // Open loop: step k+1's truth is known at step k, so its frames can render during step k.
+  const bool prefetch = !scn.closed_loop() && ro.prefetch && !hooks.frames;
   if (hooks.frames)
     fe = std::make_unique<RenderedFrontend>(scn, cam_uav, hooks.frames, hooks.features);
-  else if (scn.measurements == sim::MeasurementMode::Rendered)
+  else if (scn.measurements == sim::MeasurementMode::Rendered) {
+    // With the prefetch, detection keeps one core busy while the frames render: llvmpipe (Mesa's
+    // software rasteriser, one thread per core by default) gets the others. 1.14x against 0.99x
+    // real time on the paper scene on 2 cores (docs/results.md). LP_NUM_THREADS set by the user
+    // wins; a GPU driver ignores it.
+    if (prefetch) {
+      const unsigned cores = std::max(2u, std::thread::hardware_concurrency());
+      setenv("LP_NUM_THREADS", std::to_string(cores - 1).c_str(), /*overwrite=*/0);
+    }
     fe = std::make_unique<RenderedFrontend>(scn, cam_uav, ro.gl);
+  }
   if (fe && !ro.video.empty()) fe->open_video(ro.video);
-  // Open loop: step k+1's truth is known at step k, so its frames can render during step k.
-  if (fe) fe->set_prefetch(!scn.closed_loop() && ro.prefetch);
+  if (fe) fe->set_prefetch(prefetch);
 
   std::vector<slam::CameraRig> rigs;
   std::vector<slam::AgentInit> cam_init;
