@@ -110,7 +110,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     fe = std::make_unique<RenderedFrontend>(scn, cam_uav, hooks.frames, hooks.features);
   else if (scn.measurements == sim::MeasurementMode::Rendered) {
     // With the prefetch, detection keeps one core busy while the frames render: llvmpipe (Mesa's
-    // software rasteriser, one thread per core by default) gets the others. 1.14x against 0.99x
+    // software rasteriser, one thread per core by default) gets the others. 1.20x against 0.99x
     // real time on the paper scene on 2 cores (docs/results.md). LP_NUM_THREADS set by the user
     // wins; a GPU driver ignores it.
     if (prefetch) {

@@ -123,7 +123,7 @@ class RenderedFrontend {
   // What both constructors set up: the cameras' models and the frontend's settings from scn_.
   void init_cameras();
   double detect_camera(int cam, const slam::Estimator& est);  // ms spent
-  // Camera j's true pose and rendered frame (image effects applied) at step k.
+  // Camera j's true pose and rendered frame (image effects applied) at time t.
   void render_camera(const sim::Truth& truth, int j, double t, const render::LeadPose& lead,
                      render::Frame& frame, vision::CameraPose& pose);
   render::LeadPose true_lead_pose(const sim::Truth& truth, double t) const;
