@@ -75,6 +75,8 @@ vision::TrackingSettings tracking_settings(const sim::FrontendSpec& spec) {
   t.gate_d2 = spec.tracking_gate_d2;
   t.ratio = spec.tracking_ratio;
   t.max_search_radius_px = spec.max_search_radius_px;
+  t.max_distance = spec.tracking_max_distance;
+  t.match_latest_descriptor = spec.tracking_match_latest;
   t.validate();
   return t;
 }

@@ -22,6 +22,8 @@ struct FrontendSpec {
   double tracking_gate_d2 = 9.0;
   double tracking_ratio = 0.8;
   double max_search_radius_px = 150.0;
+  double tracking_max_distance = 0;         // descriptor distance; 0 = the descriptor's default
+  bool tracking_match_latest = false;       // also compare with the latest accepted descriptor
   // Cross-UAV matching for cooperative initialisation.
   double cross_ratio = 0.8;
   double max_epipolar_px = 5.0;

@@ -889,10 +889,12 @@ void parse_frontend(const Ctx& ctx, const Field& f, FrontendSpec& fe) {
     num(ctx, a, "min_distance_px", fe.gftt_min_distance_px, ge(0));
   }
   if (auto x = m.get("tracking")) {
-    MapView t(ctx, *x, {"gate_d2", "ratio", "max_search_radius_px"});
+    MapView t(ctx, *x, {"gate_d2", "ratio", "max_search_radius_px", "max_distance", "match_latest_descriptor"});
     num(ctx, t, "gate_d2", fe.tracking_gate_d2, gt(0));
     num(ctx, t, "ratio", fe.tracking_ratio, in(0, 1, true, false));
     num(ctx, t, "max_search_radius_px", fe.max_search_radius_px, ge(0));
+    num(ctx, t, "max_distance", fe.tracking_max_distance, ge(0));
+    boolean(ctx, t, "match_latest_descriptor", fe.tracking_match_latest);
   }
   if (auto x = m.get("cross_matching")) {
     MapView c(ctx, *x, {"ratio", "max_epipolar_px", "max_reprojection_px"});

@@ -49,11 +49,12 @@ const DescriptorStore::Entry* DescriptorStore::find(LandmarkId id) const {
   return it == entries_.end() ? nullptr : &it->second;
 }
 
-double DescriptorStore::distance(LandmarkId id, const cv::Mat& descriptor, int norm) const {
+double DescriptorStore::distance(LandmarkId id, const cv::Mat& descriptor, int norm,
+                                 bool with_latest) const {
   const Entry* e = find(id);
   if (!e) return -1.0;
   double d = cv::norm(e->initial, descriptor, norm);
-  if (!e->latest.empty()) d = std::min(d, cv::norm(e->latest, descriptor, norm));
+  if (with_latest && !e->latest.empty()) d = std::min(d, cv::norm(e->latest, descriptor, norm));
   return d;
 }
 

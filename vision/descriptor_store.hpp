@@ -1,6 +1,7 @@
 // Descriptors of the map's landmarks, keyed by landmark id. Each landmark keeps the descriptor it
 // was initialised with (an anchor that cannot drift) and the latest one the estimator accepted
-// (follows slow appearance changes: viewpoint, light); matching takes the closer of the two.
+// (follows slow appearance changes, but also lets a track slide along an object's silhouette, so
+// tracking uses it only when asked: TrackingSettings::match_latest_descriptor).
 #pragma once
 
 #include <cstdint>
@@ -35,9 +36,10 @@ class DescriptorStore {
   const Entry* find(LandmarkId id) const;
   bool contains(LandmarkId id) const { return entries_.count(id) > 0; }
   std::size_t size() const { return entries_.size(); }
-  // Smallest distance from `descriptor` to the landmark's stored descriptors (norm as in
-  // Features::norm); a negative value when the id is unknown.
-  double distance(LandmarkId id, const cv::Mat& descriptor, int norm) const;
+  // Distance from `descriptor` to the landmark's initial descriptor, or the smaller of that and
+  // the distance to its latest one when with_latest (norm as in Features::norm); a negative value
+  // when the id is unknown.
+  double distance(LandmarkId id, const cv::Mat& descriptor, int norm, bool with_latest = false) const;
 
  private:
   std::unordered_map<LandmarkId, Entry> entries_;

@@ -16,7 +16,13 @@ void TrackingSettings::validate() const {
   if (!(gate_d2 > 0)) bad("gate_d2 must be > 0, got " + std::to_string(gate_d2));
   if (!(ratio > 0 && ratio <= 1)) bad("ratio must be in (0, 1], got " + std::to_string(ratio));
   if (duplicate_radius_px < 0) bad("duplicate_radius_px must be >= 0, got " + std::to_string(duplicate_radius_px));
+  if (max_distance < 0) bad("max_distance must be >= 0 (0 = the descriptor's default), got " + std::to_string(max_distance));
   if (max_search_radius_px < 0) bad("max_search_radius_px must be >= 0, got " + std::to_string(max_search_radius_px));
+}
+
+double default_tracking_distance(const cv::Mat& descriptors) {
+  if (descriptors.type() == CV_8U) return 0.15 * 8.0 * descriptors.cols;
+  return default_max_descriptor_distance(descriptors);
 }
 
 TrackingResult track_landmarks(const std::vector<LandmarkPrediction>& predictions,
@@ -27,8 +33,7 @@ TrackingResult track_landmarks(const std::vector<LandmarkPrediction>& prediction
   const int n = frame.size();
   res.keypoint_used.assign(n, false);
   if (n == 0) return res;
-  const double max_dist = cfg.max_distance > 0 ? cfg.max_distance
-                                               : default_max_descriptor_distance(frame.descriptors);
+  const double max_dist = cfg.max_distance > 0 ? cfg.max_distance : default_tracking_distance(frame.descriptors);
 
   // Keypoints sorted by u, so each gate scans only its column band.
   std::vector<int> by_u(n);
@@ -69,7 +74,7 @@ TrackingResult track_landmarks(const std::vector<LandmarkPrediction>& prediction
       if (cfg.max_search_radius_px > 0 && r.norm() > cfg.max_search_radius_px) continue;
       const double d2 = r.dot(Sinv * r);
       if (d2 > cfg.gate_d2) continue;
-      hits.push_back({k, store.distance(p.id, frame.descriptors.row(k), frame.norm), d2});
+      hits.push_back({k, store.distance(p.id, frame.descriptors.row(k), frame.norm, cfg.match_latest_descriptor), d2});
     }
     if (hits.empty()) {
       ++res.empty_gate;

@@ -25,8 +25,12 @@ struct TrackingSettings {
   double gate_d2 = 9.0;
   // Lowe's ratio: best < ratio * second best among the keypoints inside the gate.
   double ratio = 0.8;
-  // Largest accepted descriptor distance; <= 0 takes default_max_descriptor_distance.
+  // Largest accepted descriptor distance; <= 0 takes default_tracking_distance.
   double max_distance = 0;
+  // Also compare with the landmark's latest accepted descriptor. Off: a refreshed descriptor lets
+  // a track follow a corner that slides along an object's silhouette as the view changes, which
+  // the filter then follows too (docs/results.md, rendered outliers).
+  bool match_latest_descriptor = false;
   // Keypoints closer than this to the best one are the same corner at another pyramid level and do
   // not count as its second best.
   double duplicate_radius_px = 2.0;
@@ -54,6 +58,11 @@ struct TrackingResult {
   int ambiguous = 0;          // failed the ratio test
   int lost_conflict = 0;      // another landmark took the same keypoint with a smaller distance
 };
+
+// Tracking's default max_distance: 0.15 of the bits of a binary descriptor (38 of ORB's 256),
+// tighter than cross matching's default_max_descriptor_distance because the landmark's anchor
+// descriptor is compared with a view up to tens of seconds later; 250 for float descriptors.
+double default_tracking_distance(const cv::Mat& descriptors);
 
 TrackingResult track_landmarks(const std::vector<LandmarkPrediction>& predictions,
                                const Features& frame, const DescriptorStore& store,

@@ -21,7 +21,8 @@ TEST(FrontendSettings, ValuesLandInVisionSettings) {
       "  max_features: 300\n"
       "  grid: [4, 3]\n"
       "  orb: {fast_threshold: 9, levels: 2, scale_factor: 1.5}\n"
-      "  tracking: {gate_d2: 6, ratio: 0.6, max_search_radius_px: 40}\n"
+      "  tracking: {gate_d2: 6, ratio: 0.6, max_search_radius_px: 40, max_distance: 45,\n"
+      "             match_latest_descriptor: true}\n"
       "  cross_matching: {ratio: 0.65, max_epipolar_px: 2.5, max_reprojection_px: 1.5}\n",
       "scn.yaml");
   const sim::FrontendSpec& spec = scn.front().frontend;
@@ -36,6 +37,9 @@ TEST(FrontendSettings, ValuesLandInVisionSettings) {
   EXPECT_DOUBLE_EQ(t.gate_d2, 6);
   EXPECT_DOUBLE_EQ(t.ratio, 0.6);
   EXPECT_DOUBLE_EQ(t.max_search_radius_px, 40);
+  EXPECT_DOUBLE_EQ(t.max_distance, 45);
+  EXPECT_TRUE(t.match_latest_descriptor);
+  EXPECT_FALSE(tracking_settings(sim::FrontendSpec{}).match_latest_descriptor);
   const vision::CrossMatchSettings c = cross_match_settings(spec);
   EXPECT_DOUBLE_EQ(c.ratio, 0.65);
   EXPECT_DOUBLE_EQ(c.max_epipolar_px, 2.5);

@@ -554,7 +554,7 @@ frontend:
   grid: [6, 5]
   orb: {fast_threshold: 15, levels: 3, scale_factor: 1.3}
   gftt: {quality: 0.01, min_distance_px: 7}
-  tracking: {gate_d2: 11.8, ratio: 0.7, max_search_radius_px: 80}
+  tracking: {gate_d2: 11.8, ratio: 0.7, max_search_radius_px: 80, max_distance: 50, match_latest_descriptor: true}
   cross_matching: {ratio: 0.75, max_epipolar_px: 4, max_reprojection_px: 3}
 variants:
   - name: a
@@ -576,6 +576,8 @@ variants:
   EXPECT_DOUBLE_EQ(f.tracking_gate_d2, 11.8);
   EXPECT_DOUBLE_EQ(f.tracking_ratio, 0.7);
   EXPECT_DOUBLE_EQ(f.max_search_radius_px, 80);
+  EXPECT_DOUBLE_EQ(f.tracking_max_distance, 50);
+  EXPECT_TRUE(f.tracking_match_latest);
   EXPECT_DOUBLE_EQ(f.cross_ratio, 0.75);
   EXPECT_DOUBLE_EQ(f.max_epipolar_px, 4);
   EXPECT_DOUBLE_EQ(f.max_reprojection_px, 3);

@@ -158,6 +158,34 @@ TEST(Tracking, OneLandmarkPerKeypointTheCloserDescriptorWins) {
   EXPECT_EQ(r.lost_conflict, 1);
 }
 
+// A track whose accepted descriptors drifted away from its anchor (a corner sliding along a
+// silhouette) is lost by default; match_latest_descriptor keeps it.
+TEST(Tracking, ADescriptorThatLeftItsAnchorIsNotTrackedUnlessLatestIsAllowed) {
+  const test::PlaneScene scene;
+  const CameraView a = test::view_at({0, 0, 15});
+  const Features f = FeatureExtractor().detect(scene.render(a));
+  cv::Mat anchor = f.descriptors.row(5).clone();
+  for (int b = 0; b < 6; ++b) anchor.at<uchar>(0, b) ^= 0xFF;  // 48 bits from the keypoint
+  DescriptorStore store;
+  store.add(10, anchor, 0);
+  store.observe(10, f.descriptors.row(5), 3);
+  const Eigen::Matrix2d S = 4 * Eigen::Matrix2d::Identity();
+  TrackingSettings cfg;
+  EXPECT_DOUBLE_EQ(default_tracking_distance(f.descriptors), 38.4);
+  auto r = track_landmarks({{10, f.pixel(5), S}}, f, store, cfg);
+  EXPECT_TRUE(r.candidates.empty());
+  EXPECT_EQ(r.too_far, 1);
+  cfg.max_distance = 64;  // the old default, 0.25 of the bits: the anchor alone matches again
+  r = track_landmarks({{10, f.pixel(5), S}}, f, store, cfg);
+  ASSERT_EQ(r.candidates.size(), 1u);
+  cfg.max_distance = 0;
+  cfg.match_latest_descriptor = true;
+  r = track_landmarks({{10, f.pixel(5), S}}, f, store, cfg);
+  ASSERT_EQ(r.candidates.size(), 1u);
+  EXPECT_EQ(r.candidates[0].keypoint, 5);
+  EXPECT_EQ(r.candidates[0].distance, 0);
+}
+
 TEST(Tracking, UnknownIdsAreSkippedAndFreeKeypointsAvoidLandmarks) {
   const test::PlaneScene scene;
   const Features f = FeatureExtractor().detect(scene.render(test::view_at({0, 0, 15})));
@@ -189,7 +217,8 @@ TEST(DescriptorStore, KeepsInitialAndLatestAndAges) {
   s.add(2, d0, 0);
   EXPECT_EQ(s.distance(1, q, cv::NORM_HAMMING), 248);
   s.observe(1, d1, 5);
-  EXPECT_EQ(s.distance(1, q, cv::NORM_HAMMING), 8);  // the latest is closer
+  EXPECT_EQ(s.distance(1, q, cv::NORM_HAMMING), 248);  // the anchor only, unless asked
+  EXPECT_EQ(s.distance(1, q, cv::NORM_HAMMING, true), 8);  // the latest is closer
   EXPECT_EQ(s.find(1)->observations, 1);
   EXPECT_LT(s.distance(7, q, cv::NORM_HAMMING), 0);
   EXPECT_EQ(s.prune(10, 6), std::vector<LandmarkId>{2});  // 1 was seen at 5, 2 only at 0
