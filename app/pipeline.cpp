@@ -32,6 +32,7 @@ slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
   slam::EstimatorSettings s;
   s.accel_sigma_lead = e.accel_sigma_lead;
   s.accel_sigma_uav = e.accel_sigma_uav;
+  s.accel_sigma_common = e.accel_sigma_common;
   s.pixel_sigma = e.pixel_sigma;
   s.gps_sigma = e.gps_sigma;
   s.altimeter_sigma = e.altimeter_sigma;

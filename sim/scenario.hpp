@@ -116,6 +116,8 @@ struct EstimatorSpec {
   // Process noise: white acceleration (eq. 34), m/s^2.
   double accel_sigma_lead = 0.05;
   double accel_sigma_uav = 0.05;
+  // An acceleration every agent shares (formation flight), on top of the two above.
+  double accel_sigma_common = 0;
   // Measurement noise the filter assumes (R); may differ from the truth's.
   double pixel_sigma = 3.0;
   double gps_sigma = 1.5;

@@ -567,9 +567,10 @@ void parse_estimator(const Ctx& ctx, const Field& f, EstimatorSpec& e, Provenanc
     prov.single_uav = sf->loc();
   }
   if (auto pf = m.get("process_noise")) {
-    MapView p(ctx, *pf, {"accel_sigma_lead", "accel_sigma_uav"});
+    MapView p(ctx, *pf, {"accel_sigma_lead", "accel_sigma_uav", "accel_sigma_common"});
     num(ctx, p, "accel_sigma_lead", e.accel_sigma_lead, ge(0));
     num(ctx, p, "accel_sigma_uav", e.accel_sigma_uav, ge(0));
+    num(ctx, p, "accel_sigma_common", e.accel_sigma_common, ge(0));
   }
   if (auto rf = m.get("measurement_noise")) {
     MapView r(ctx, *rf, {"pixel_sigma", "gps_sigma", "altimeter_sigma", "range_sigma",

@@ -39,7 +39,7 @@ Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
 }
 
 void Estimator::predict(double dt) {
-  predict_constant_velocity(s_, dt, cfg_.accel_sigma_lead, cfg_.accel_sigma_uav);
+  predict_constant_velocity(s_, dt, cfg_.accel_sigma_lead, cfg_.accel_sigma_uav, cfg_.accel_sigma_common);
   for (int j = 0; j < num_cameras(); ++j)
     predict_gimbal_error(s_, j, dt, cams_[j].orientation_sigma, cfg_.gimbal_time_constant);
 }

@@ -4,7 +4,8 @@
 
 namespace wingman::slam {
 
-void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav) {
+void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav,
+                               double sigma_a_common) {
   auto propagate = [&](int pos, int vel, double sigma_a) {
     s.x.segment<3>(pos) += dt * s.x.segment<3>(vel);  // eq. 41
     // A P A^T, eq. 42: rows then columns of the position block gain dt times the velocity's.
@@ -16,6 +17,15 @@ void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, d
   propagate(FilterState::lead_pos(), FilterState::lead_vel(), sigma_a_lead);
   for (int j = 0; j < s.num_cameras(); ++j)
     propagate(FilterState::cam_pos(j), FilterState::cam_vel(j), sigma_a_uav);
+  if (sigma_a_common > 0) {
+    const double q = (sigma_a_common * dt) * (sigma_a_common * dt);
+    for (int a = -1; a < s.num_cameras(); ++a)
+      for (int b = -1; b < s.num_cameras(); ++b) {
+        const int va = a < 0 ? FilterState::lead_vel() : FilterState::cam_vel(a);
+        const int vb = b < 0 ? FilterState::lead_vel() : FilterState::cam_vel(b);
+        s.P.block<3, 3>(va, vb).diagonal().array() += q;
+      }
+  }
 }
 
 void predict_gimbal_error(FilterState& s, int j, double dt, double sigma, double tau) {

@@ -8,7 +8,12 @@
 namespace wingman::slam {
 
 // sigma_a_*: std of the white acceleration (m/s^2); the velocity takes noise a dt (eq. 34).
-void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav);
+// sigma_a_common: an acceleration every agent shares. Agents in formation accelerate together; with
+// independent noise only, a common acceleration that landmarks reveal for the UAVs is not passed
+// on to the lead, whose velocity then lags and is overconfident (docs/results.md). The velocity
+// blocks of agents i and k take (sigma_common^2 + [i = k] sigma_i^2) dt^2 I.
+void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav,
+                               double sigma_a_common = 0);
 
 // Camera j's gimbal error, when the state holds it, as a first-order Gauss-Markov process with
 // stationary std `sigma` (rad) and correlation time `tau` (s): a <- exp(-dt/tau) a, with noise

@@ -82,7 +82,7 @@ outages:
 estimator:
   mode: multi
   single_uav: uav1
-  process_noise: {accel_sigma_lead: 0.1, accel_sigma_uav: 0.2}
+  process_noise: {accel_sigma_lead: 0.1, accel_sigma_uav: 0.2, accel_sigma_common: 0.3}
   measurement_noise: {pixel_sigma: 4}
   initial_sigma: {position: 0.01, velocity: 0.02}
   gating: {probability: 0.99, one_point_ransac: false, ransac_inlier_px: 3,
@@ -150,6 +150,7 @@ TEST(ScenarioYaml, FullDocumentParses) {
   EXPECT_EQ(s.outages[1].agent, "");
   EXPECT_EQ(s.estimator.mode, EstimatorMode::MultiUav);
   EXPECT_DOUBLE_EQ(s.estimator.accel_sigma_uav, 0.2);
+  EXPECT_DOUBLE_EQ(s.estimator.accel_sigma_common, 0.3);
   EXPECT_DOUBLE_EQ(s.estimator.pixel_sigma, 4);
   EXPECT_DOUBLE_EQ(s.estimator.gps_sigma, 1.5);  // default
   EXPECT_DOUBLE_EQ(s.estimator.initial_velocity_sigma, 0.02);

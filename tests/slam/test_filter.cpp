@@ -39,20 +39,28 @@ FilterState two_camera_state_with_landmarks(int n_landmarks, std::mt19937_64& rn
 }  // namespace
 
 TEST(Prediction, EqualsDenseAPAtPlusQ) {
+  for (const double sc : {0.0, 0.25}) {
+  SCOPED_TRACE("common sigma " + std::to_string(sc));
   std::mt19937_64 rng(3);
   FilterState s = two_camera_state_with_landmarks(4, rng);
   const FilterState before = s;
   const double dt = 0.1, sl = 0.2, su = 0.3;
-  predict_constant_velocity(s, dt, sl, su);
+  predict_constant_velocity(s, dt, sl, su, sc);
   const int n = s.dim();
   Eigen::MatrixXd A = Eigen::MatrixXd::Identity(n, n), Q = Eigen::MatrixXd::Zero(n, n);
+  // The acceleration noise of agent a is w_a + w_common: G = [W_lead 0 0 W; 0 W_uav1 0 W; ...].
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, 12), Qw = Eigen::MatrixXd::Zero(12, 12);
   for (int a = 0; a < 3; ++a) {
     const int p = 6 * a;
     A.block<3, 3>(p, p + 3) = dt * Eigen::Matrix3d::Identity();
-    Q.block<3, 3>(p + 3, p + 3) = std::pow((a == 0 ? sl : su) * dt, 2) * Eigen::Matrix3d::Identity();
+    G.block<3, 3>(p + 3, 3 * a) = G.block<3, 3>(p + 3, 9) = dt * Eigen::Matrix3d::Identity();
+    Qw.block<3, 3>(3 * a, 3 * a) = std::pow(a == 0 ? sl : su, 2) * Eigen::Matrix3d::Identity();
   }
+  Qw.block<3, 3>(9, 9) = sc * sc * Eigen::Matrix3d::Identity();
+  Q = G * Qw * G.transpose();
   EXPECT_LT((s.x - A * before.x).norm(), 1e-12);
   EXPECT_LT((s.P - (A * before.P * A.transpose() + Q)).norm(), 1e-12);
+  }
 }
 
 // The gimbal errors' Gauss-Markov prediction equals the dense F P F^T + Q, and with no
