@@ -33,6 +33,8 @@ slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
   s.accel_sigma_lead = e.accel_sigma_lead;
   s.accel_sigma_uav = e.accel_sigma_uav;
   s.accel_sigma_common = e.accel_sigma_common;
+  s.common_accel_state_sigma = e.common_accel_state_sigma;
+  s.common_accel_state_time_constant = e.common_accel_state_time_constant;
   s.pixel_sigma = e.pixel_sigma;
   s.gps_sigma = e.gps_sigma;
   s.altimeter_sigma = e.altimeter_sigma;

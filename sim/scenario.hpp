@@ -118,6 +118,8 @@ struct EstimatorSpec {
   double accel_sigma_uav = 0.05;
   // An acceleration every agent shares (formation flight), on top of the two above.
   double accel_sigma_common = 0;
+  // > 0 (both): the shared acceleration is a state, Gauss-Markov with this std and correlation time.
+  double common_accel_state_sigma = 0, common_accel_state_time_constant = 0;
   // Measurement noise the filter assumes (R); may differ from the truth's.
   double pixel_sigma = 3.0;
   double gps_sigma = 1.5;

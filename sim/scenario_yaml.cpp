@@ -567,10 +567,15 @@ void parse_estimator(const Ctx& ctx, const Field& f, EstimatorSpec& e, Provenanc
     prov.single_uav = sf->loc();
   }
   if (auto pf = m.get("process_noise")) {
-    MapView p(ctx, *pf, {"accel_sigma_lead", "accel_sigma_uav", "accel_sigma_common"});
+    MapView p(ctx, *pf, {"accel_sigma_lead", "accel_sigma_uav", "accel_sigma_common", "common_acceleration_state"});
     num(ctx, p, "accel_sigma_lead", e.accel_sigma_lead, ge(0));
     num(ctx, p, "accel_sigma_uav", e.accel_sigma_uav, ge(0));
     num(ctx, p, "accel_sigma_common", e.accel_sigma_common, ge(0));
+    if (auto cf = p.get("common_acceleration_state")) {
+      MapView c(ctx, *cf, {"sigma", "time_constant"});
+      num(ctx, c, "sigma", e.common_accel_state_sigma, ge(0));
+      num(ctx, c, "time_constant", e.common_accel_state_time_constant, ge(0));
+    }
   }
   if (auto rf = m.get("measurement_noise")) {
     MapView r(ctx, *rf, {"pixel_sigma", "gps_sigma", "altimeter_sigma", "range_sigma",

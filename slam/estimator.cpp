@@ -15,7 +15,8 @@ Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
       s_(static_cast<int>(cams_.size()),
          settings.gimbal_time_constant > 0 &&
              std::any_of(cams_.begin(), cams_.end(),
-                         [](const CameraRig& c) { return c.orientation_sigma > 0; })),
+                         [](const CameraRig& c) { return c.orientation_sigma > 0; }),
+         settings.common_accel_state_sigma > 0 && settings.common_accel_state_time_constant > 0),
       rng_(settings.seed) {
   if (camera_init.size() != cams_.size())
     throw std::invalid_argument("Estimator: one initial state per camera");
@@ -32,6 +33,8 @@ Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
   for (int j = 0; j < num_cameras(); ++j)
     if (const int g = s_.gimbal(j); g >= 0)
       s_.P.block<2, 2>(g, g).diagonal().setConstant(cams_[j].orientation_sigma * cams_[j].orientation_sigma);
+  if (const int a = s_.common_acceleration(); a >= 0)
+    s_.P.block<3, 3>(a, a).diagonal().setConstant(cfg_.common_accel_state_sigma * cfg_.common_accel_state_sigma);
   cfg_.visual.sigma_px = cfg_.pixel_sigma;
   cfg_.visual.gate_probability = cfg_.gate_probability;
   cfg_.cooperative.sigma_px = cfg_.pixel_sigma;
@@ -42,6 +45,7 @@ void Estimator::predict(double dt) {
   predict_constant_velocity(s_, dt, cfg_.accel_sigma_lead, cfg_.accel_sigma_uav, cfg_.accel_sigma_common);
   for (int j = 0; j < num_cameras(); ++j)
     predict_gimbal_error(s_, j, dt, cams_[j].orientation_sigma, cfg_.gimbal_time_constant);
+  predict_common_acceleration(s_, dt, cfg_.common_accel_state_sigma, cfg_.common_accel_state_time_constant);
 }
 
 std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {

@@ -22,6 +22,8 @@ namespace wingman::slam {
 struct EstimatorSettings {
   double accel_sigma_lead = 0.05, accel_sigma_uav = 0.05;  // eq. 34
   double accel_sigma_common = 0;  // shared by every agent (motion_model.hpp)
+  // > 0: a shared acceleration state, Gauss-Markov with this std (m/s^2) and correlation time (s).
+  double common_accel_state_sigma = 0, common_accel_state_time_constant = 0;
   double pixel_sigma = 3, gps_sigma = 1.5, altimeter_sigma = 0.5, range_sigma = 0.5;
   double initial_position_sigma = 1e-3, initial_velocity_sigma = 1e-3;
   // > 0: each camera's gimbal error is a Gauss-Markov state with this correlation time (s) and

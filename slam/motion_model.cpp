@@ -28,6 +28,33 @@ void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, d
   }
 }
 
+void predict_common_acceleration(FilterState& s, double dt, double sigma, double tau) {
+  const int a = s.common_acceleration();
+  if (a < 0) return;
+  const double phi = std::exp(-dt / tau);
+  const Eigen::Vector3d acc = s.x.segment<3>(a);
+  // F = I + E_pa dt^2/2 + E_va dt + E_aa (phi - 1), on rows then columns; a's rows and columns
+  // change last, so the others use its old values.
+  auto agent = [&](int pos, int vel) {
+    s.x.segment<3>(pos) += 0.5 * dt * dt * acc;
+    s.x.segment<3>(vel) += dt * acc;
+    s.P.middleRows(pos, 3) += 0.5 * dt * dt * s.P.middleRows(a, 3);
+    s.P.middleRows(vel, 3) += dt * s.P.middleRows(a, 3);
+  };
+  auto agent_cols = [&](int pos, int vel) {
+    s.P.middleCols(pos, 3) += 0.5 * dt * dt * s.P.middleCols(a, 3);
+    s.P.middleCols(vel, 3) += dt * s.P.middleCols(a, 3);
+  };
+  agent(FilterState::lead_pos(), FilterState::lead_vel());
+  for (int j = 0; j < s.num_cameras(); ++j) agent(FilterState::cam_pos(j), FilterState::cam_vel(j));
+  s.x.segment<3>(a) *= phi;
+  s.P.middleRows(a, 3) *= phi;
+  agent_cols(FilterState::lead_pos(), FilterState::lead_vel());
+  for (int j = 0; j < s.num_cameras(); ++j) agent_cols(FilterState::cam_pos(j), FilterState::cam_vel(j));
+  s.P.middleCols(a, 3) *= phi;
+  s.P.block<3, 3>(a, a).diagonal().array() += (1 - phi * phi) * sigma * sigma;
+}
+
 void predict_gimbal_error(FilterState& s, int j, double dt, double sigma, double tau) {
   const int g = s.gimbal(j);
   if (g < 0) return;

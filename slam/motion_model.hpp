@@ -15,6 +15,14 @@ namespace wingman::slam {
 void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav,
                                double sigma_a_common = 0);
 
+// The shared acceleration a, when the state holds it (FilterState::common_acceleration): every
+// agent's position gains dt^2/2 a and its velocity dt a; a itself is a first-order Gauss-Markov
+// process (Singer) with stationary std `sigma` (m/s^2) and correlation time `tau` (s). The
+// formation's manoeuvre is smooth and slow, which white acceleration noise describes badly: to
+// follow it, white noise must be large, and the velocities come out conservative. Applied after
+// predict_constant_velocity (the composition is the Singer transition). A no-op without the state.
+void predict_common_acceleration(FilterState& s, double dt, double sigma, double tau);
+
 // Camera j's gimbal error, when the state holds it, as a first-order Gauss-Markov process with
 // stationary std `sigma` (rad) and correlation time `tau` (s): a <- exp(-dt/tau) a, with noise
 // (1 - exp(-2 dt/tau)) sigma^2 so that its variance tends to sigma^2. A slowly varying pointing

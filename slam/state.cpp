@@ -7,8 +7,8 @@
 
 namespace wingman::slam {
 
-FilterState::FilterState(int num_cameras, bool gimbal_states)
-    : num_cameras_(num_cameras), gimbal_states_(gimbal_states) {
+FilterState::FilterState(int num_cameras, bool gimbal_states, bool common_acceleration)
+    : num_cameras_(num_cameras), gimbal_states_(gimbal_states), common_accel_(common_acceleration) {
   if (num_cameras < 1) throw std::invalid_argument("FilterState: at least one camera");
   x = Eigen::VectorXd::Zero(agent_dim());
   P = Eigen::MatrixXd::Zero(agent_dim(), agent_dim());

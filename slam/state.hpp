@@ -1,7 +1,8 @@
 // The filter state of paper eq. 2 and its covariance: x = [x_h, v_h, x_c^1, v_c^1, ..., x_a^i],
 // for any number of cameras, optionally with each gimbal's pointing error (two angles per camera,
 // after the agents and before the landmarks) when the filter estimates it instead of treating it
-// as white noise. Landmarks are Euclidean (3 parameters, eq. 2) or inverse depth
+// as white noise, and optionally one acceleration every agent shares (after the gimbal angles; the
+// formation's common manoeuvre as a Gauss-Markov process). Landmarks are Euclidean (3 parameters, eq. 2) or inverse depth
 // (6 parameters [x0 y0 z0 theta phi rho], Montiel et al. 2006) for the single-UAV baseline.
 #pragma once
 
@@ -25,7 +26,7 @@ struct LandmarkSlot {
 
 class FilterState {
  public:
-  explicit FilterState(int num_cameras, bool gimbal_states = false);
+  explicit FilterState(int num_cameras, bool gimbal_states = false, bool common_acceleration = false);
 
   Eigen::VectorXd x;
   Eigen::MatrixXd P;
@@ -39,7 +40,13 @@ class FilterState {
   // First of camera j's two gimbal angles (about its x and y axes), or -1 when not estimated.
   int gimbal(int j) const { return gimbal_states_ ? kinematic_dim() + 2 * j : -1; }
   bool has_gimbal_states() const { return gimbal_states_; }
-  int agent_dim() const { return kinematic_dim() + (gimbal_states_ ? 2 * num_cameras_ : 0); }
+  // First of the three components of the shared acceleration, or -1 when not estimated.
+  int common_acceleration() const {
+    return common_accel_ ? kinematic_dim() + (gimbal_states_ ? 2 * num_cameras_ : 0) : -1;
+  }
+  int agent_dim() const {
+    return kinematic_dim() + (gimbal_states_ ? 2 * num_cameras_ : 0) + (common_accel_ ? 3 : 0);
+  }
   int dim() const { return static_cast<int>(x.size()); }
 
   const std::vector<LandmarkSlot>& landmarks() const { return landmarks_; }
@@ -60,6 +67,7 @@ class FilterState {
  private:
   int num_cameras_;
   bool gimbal_states_;
+  bool common_accel_;
   std::vector<LandmarkSlot> landmarks_;
   LandmarkId next_id_ = 0;
 };

@@ -97,6 +97,22 @@ TEST_P(PipelineVariant, CovarianceStaysSymmetricPositiveDefinite) {
               GetParam().c_str(), log.max_dim, log.min_agent_eigenvalue, log.max_asymmetry);
 }
 
+// The same with the shared Gauss-Markov acceleration in the state (process_noise.
+// common_acceleration_state): three more agent states, still SPD, and the agents' NEES stays finite.
+TEST(Pipeline, CovarianceStaysSymmetricPositiveDefiniteWithTheCommonAccelerationState) {
+  sim::Scenario scn = smoke_variant("multi");
+  scn.estimator.common_accel_state_sigma = 0.05;
+  scn.estimator.common_accel_state_time_constant = 60;
+  CovarianceLog log;
+  const auto rec = run_synthetic(scn, {}, covariance_checker(log));
+  EXPECT_EQ(log.calls, scn.num_steps());
+  EXPECT_EQ(log.nonfinite_steps, 0);
+  EXPECT_EQ(log.asymmetric_steps, 0) << "max |P - P^T| = " << log.max_asymmetry;
+  EXPECT_EQ(log.not_pd_steps, 0) << "first at k=" << log.first_not_pd_k;
+  EXPECT_GT(log.min_agent_eigenvalue, 0.0);
+  for (const auto& st : rec.steps) EXPECT_TRUE(std::isfinite(st.nees) || st.k == 0);
+}
+
 TEST_P(PipelineVariant, RunRecordIsComplete) {
   const sim::Scenario scn = smoke_variant(GetParam());
   const auto rec = run_synthetic(scn);

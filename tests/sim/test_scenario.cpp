@@ -82,7 +82,8 @@ outages:
 estimator:
   mode: multi
   single_uav: uav1
-  process_noise: {accel_sigma_lead: 0.1, accel_sigma_uav: 0.2, accel_sigma_common: 0.3}
+  process_noise: {accel_sigma_lead: 0.1, accel_sigma_uav: 0.2, accel_sigma_common: 0.3,
+                  common_acceleration_state: {sigma: 0.05, time_constant: 60}}
   measurement_noise: {pixel_sigma: 4}
   initial_sigma: {position: 0.01, velocity: 0.02}
   gating: {probability: 0.99, one_point_ransac: false, ransac_inlier_px: 3,
@@ -151,6 +152,8 @@ TEST(ScenarioYaml, FullDocumentParses) {
   EXPECT_EQ(s.estimator.mode, EstimatorMode::MultiUav);
   EXPECT_DOUBLE_EQ(s.estimator.accel_sigma_uav, 0.2);
   EXPECT_DOUBLE_EQ(s.estimator.accel_sigma_common, 0.3);
+  EXPECT_DOUBLE_EQ(s.estimator.common_accel_state_sigma, 0.05);
+  EXPECT_DOUBLE_EQ(s.estimator.common_accel_state_time_constant, 60);
   EXPECT_DOUBLE_EQ(s.estimator.pixel_sigma, 4);
   EXPECT_DOUBLE_EQ(s.estimator.gps_sigma, 1.5);  // default
   EXPECT_DOUBLE_EQ(s.estimator.initial_velocity_sigma, 0.02);

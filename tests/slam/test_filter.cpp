@@ -93,6 +93,48 @@ TEST(Prediction, GimbalErrorIsGaussMarkov) {
   EXPECT_EQ(FilterState(2).gimbal(0), -1);
 }
 
+// The shared acceleration's prediction equals the dense F P F^T + Q of the Singer model (every
+// agent's position gains dt^2/2 a, its velocity dt a; a is Gauss-Markov), with landmarks and
+// gimbal states in the state too; its variance tends to sigma^2 and P stays symmetric.
+TEST(Prediction, CommonAccelerationIsSingerForEveryAgent) {
+  FilterState s(2, true, true);
+  ASSERT_EQ(s.common_acceleration(), s.kinematic_dim() + 4);
+  ASSERT_EQ(s.agent_dim(), s.kinematic_dim() + 4 + 3);
+  s.add_landmark(LandmarkKind::Euclidean, Eigen::Vector3d(1, 2, 0), Eigen::MatrixXd::Zero(3, s.dim()),
+                 Eigen::Matrix3d::Identity());
+  std::mt19937 rng(4);
+  std::normal_distribution<double> n;
+  const Eigen::MatrixXd A = Eigen::MatrixXd::NullaryExpr(s.dim(), s.dim(), [&] { return n(rng); });
+  s.P = A * A.transpose();
+  s.x = Eigen::VectorXd::NullaryExpr(s.dim(), [&] { return n(rng); });
+  const double dt = 0.1, sigma = 0.05, tau = 60;
+  const double phi = std::exp(-dt / tau);
+  const int a = s.common_acceleration();
+  Eigen::MatrixXd F = Eigen::MatrixXd::Identity(s.dim(), s.dim());
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(s.dim(), s.dim());
+  for (int agent = 0; agent < 3; ++agent) {
+    const int p = 6 * agent;
+    F.block<3, 3>(p, a) = 0.5 * dt * dt * Eigen::Matrix3d::Identity();
+    F.block<3, 3>(p + 3, a) = dt * Eigen::Matrix3d::Identity();
+  }
+  F.block<3, 3>(a, a) = phi * Eigen::Matrix3d::Identity();
+  Q.block<3, 3>(a, a) = (1 - phi * phi) * sigma * sigma * Eigen::Matrix3d::Identity();
+  const Eigen::VectorXd x_dense = F * s.x;
+  const Eigen::MatrixXd P_dense = F * s.P * F.transpose() + Q;
+  predict_common_acceleration(s, dt, sigma, tau);
+  EXPECT_LT((s.x - x_dense).norm(), 1e-12);
+  EXPECT_LT((s.P - P_dense).norm(), 1e-10);
+  EXPECT_LT((s.P - s.P.transpose()).norm(), 1e-10);
+
+  for (int k = 0; k < 20000; ++k) predict_common_acceleration(s, dt, sigma, tau);
+  EXPECT_NEAR(s.P(a, a), sigma * sigma, 1e-6);
+  EXPECT_EQ(FilterState(2, true).common_acceleration(), -1);
+  FilterState none(1);
+  const FilterState before = none;
+  predict_common_acceleration(none, dt, sigma, tau);  // no such state: nothing happens
+  EXPECT_EQ((none.P - before.P).norm(), 0.0);
+}
+
 TEST(Update, SparseUpdateEqualsDenseKalmanUpdate) {
   std::mt19937_64 rng(5);
   FilterState s = two_camera_state_with_landmarks(6, rng);
