@@ -1,9 +1,10 @@
 // The filter state of paper eq. 2 and its covariance: x = [x_h, v_h, x_c^1, v_c^1, ..., x_a^i],
 // for any number of cameras, optionally with each gimbal's pointing error (two angles per camera,
 // after the agents and before the landmarks) when the filter estimates it instead of treating it
-// as white noise, and optionally one acceleration every agent shares (after the gimbal angles; the
-// formation's common manoeuvre as a Gauss-Markov process). Landmarks are Euclidean (3 parameters, eq. 2) or inverse depth
-// (6 parameters [x0 y0 z0 theta phi rho], Montiel et al. 2006) for the single-UAV baseline.
+// as white noise, and optionally one acceleration every agent shares (after the gimbal angles: the
+// formation's common manoeuvre as a Gauss-Markov process). Landmarks are Euclidean (3 parameters,
+// eq. 2) or inverse depth (6 parameters [x0 y0 z0 theta phi rho], Montiel et al. 2006) for the
+// single-UAV baseline.
 #pragma once
 
 #include <Eigen/Core>

@@ -25,7 +25,7 @@ struct TrackingSettings {
   double gate_d2 = 9.0;
   // Lowe's ratio: best < ratio * second best among the keypoints inside the gate.
   double ratio = 0.8;
-  // Largest accepted descriptor distance; <= 0 takes default_tracking_distance.
+  // Largest accepted descriptor distance; 0 takes default_tracking_distance.
   double max_distance = 0;
   // Also compare with the landmark's latest accepted descriptor. Off: a refreshed descriptor lets
   // a track follow a corner that slides along an object's silhouette as the view changes, which
