@@ -1,30 +1,36 @@
 #include "slam/motion_model.hpp"
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 namespace wingman::slam {
 
+namespace {
+// (position, velocity) column of every agent: the lead, then each camera.
+std::vector<std::pair<int, int>> agent_blocks(const FilterState& s) {
+  std::vector<std::pair<int, int>> b = {{FilterState::lead_pos(), FilterState::lead_vel()}};
+  for (int j = 0; j < s.num_cameras(); ++j) b.emplace_back(FilterState::cam_pos(j), FilterState::cam_vel(j));
+  return b;
+}
+}  // namespace
+
 void predict_constant_velocity(FilterState& s, double dt, double sigma_a_lead, double sigma_a_uav,
                                double sigma_a_common) {
-  auto propagate = [&](int pos, int vel, double sigma_a) {
+  const auto agents = agent_blocks(s);
+  for (const auto& [pos, vel] : agents) {
+    const double sigma_a = pos == FilterState::lead_pos() ? sigma_a_lead : sigma_a_uav;
     s.x.segment<3>(pos) += dt * s.x.segment<3>(vel);  // eq. 41
     // A P A^T, eq. 42: rows then columns of the position block gain dt times the velocity's.
     s.P.middleRows(pos, 3) += dt * s.P.middleRows(vel, 3);
     s.P.middleCols(pos, 3) += dt * s.P.middleCols(vel, 3);
     // W Q W^T: white acceleration integrated over dt enters the velocity.
     s.P.block<3, 3>(vel, vel).diagonal().array() += (sigma_a * dt) * (sigma_a * dt);
-  };
-  propagate(FilterState::lead_pos(), FilterState::lead_vel(), sigma_a_lead);
-  for (int j = 0; j < s.num_cameras(); ++j)
-    propagate(FilterState::cam_pos(j), FilterState::cam_vel(j), sigma_a_uav);
+  }
   if (sigma_a_common > 0) {
     const double q = (sigma_a_common * dt) * (sigma_a_common * dt);
-    for (int a = -1; a < s.num_cameras(); ++a)
-      for (int b = -1; b < s.num_cameras(); ++b) {
-        const int va = a < 0 ? FilterState::lead_vel() : FilterState::cam_vel(a);
-        const int vb = b < 0 ? FilterState::lead_vel() : FilterState::cam_vel(b);
-        s.P.block<3, 3>(va, vb).diagonal().array() += q;
-      }
+    for (const auto& a : agents)
+      for (const auto& b : agents) s.P.block<3, 3>(a.second, b.second).diagonal().array() += q;
   }
 }
 
@@ -33,24 +39,21 @@ void predict_common_acceleration(FilterState& s, double dt, double sigma, double
   if (a < 0) return;
   const double phi = std::exp(-dt / tau);
   const Eigen::Vector3d acc = s.x.segment<3>(a);
+  const auto agents = agent_blocks(s);
   // F = I + E_pa dt^2/2 + E_va dt + E_aa (phi - 1), on rows then columns; a's rows and columns
   // change last, so the others use its old values.
-  auto agent = [&](int pos, int vel) {
+  for (const auto& [pos, vel] : agents) {
     s.x.segment<3>(pos) += 0.5 * dt * dt * acc;
     s.x.segment<3>(vel) += dt * acc;
     s.P.middleRows(pos, 3) += 0.5 * dt * dt * s.P.middleRows(a, 3);
     s.P.middleRows(vel, 3) += dt * s.P.middleRows(a, 3);
-  };
-  auto agent_cols = [&](int pos, int vel) {
-    s.P.middleCols(pos, 3) += 0.5 * dt * dt * s.P.middleCols(a, 3);
-    s.P.middleCols(vel, 3) += dt * s.P.middleCols(a, 3);
-  };
-  agent(FilterState::lead_pos(), FilterState::lead_vel());
-  for (int j = 0; j < s.num_cameras(); ++j) agent(FilterState::cam_pos(j), FilterState::cam_vel(j));
+  }
   s.x.segment<3>(a) *= phi;
   s.P.middleRows(a, 3) *= phi;
-  agent_cols(FilterState::lead_pos(), FilterState::lead_vel());
-  for (int j = 0; j < s.num_cameras(); ++j) agent_cols(FilterState::cam_pos(j), FilterState::cam_vel(j));
+  for (const auto& [pos, vel] : agents) {
+    s.P.middleCols(pos, 3) += 0.5 * dt * dt * s.P.middleCols(a, 3);
+    s.P.middleCols(vel, 3) += dt * s.P.middleCols(a, 3);
+  }
   s.P.middleCols(a, 3) *= phi;
   s.P.block<3, 3>(a, a).diagonal().array() += (1 - phi * phi) * sigma * sigma;
 }
