@@ -148,6 +148,9 @@ struct EstimatorSpec {
   // Cooperative initialisation (eq. 47-52).
   double min_parallax_deg = 3.0;
   double max_reprojection_px = 10.0;
+  // A pair under min_parallax_deg becomes an inverse-depth landmark anchored at the first camera
+  // and corrected with the second pixel, instead of being rejected.
+  bool low_parallax_inverse_depth = false;
   // Single-UAV inverse-depth initialisation (Montiel et al. 2006, Civera et al. 2008).
   double inverse_depth_rho = 0.05;    // 1/m
   double inverse_depth_sigma = 0.04;  // 1/m

@@ -119,6 +119,10 @@ std::vector<InitOutcome> Estimator::initialise_from_matches(const std::vector<Cr
     }
     auto r = initialise_cooperative(s_, m.cam_a, cams_[m.cam_a], m.uv_a, m.cam_b, cams_[m.cam_b],
                                     m.uv_b, cfg_.cooperative);
+    if (!r.id && r.rejected_because == kLowParallax && cfg_.cooperative.low_parallax_inverse_depth)
+      r = initialise_cooperative_inverse_depth(s_, m.cam_a, cams_[m.cam_a], m.uv_a, m.cam_b,
+                                               cams_[m.cam_b], m.uv_b, cfg_.inverse_depth,
+                                               cfg_.gate_probability);
     if (r.id) tracks_[*r.id].matched = true;  // seen now: no miss on its first step
     out.push_back(std::move(r));
   }

@@ -3,7 +3,9 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "slam/ekf_update.hpp"
 #include "slam/inverse_depth.hpp"
+#include "slam/visual_update.hpp"
 
 namespace wingman::slam {
 
@@ -105,7 +107,7 @@ InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& c
   if (!t) return {std::nullopt, "degenerate"};
   const Eigen::Vector3d pC_a = rig_a.R_CW * (t->point - x_a), pC_b = rig_b.R_CW * (t->point - x_b);
   if (pC_a.z() <= 0 || pC_b.z() <= 0) return {std::nullopt, "negative depth"};
-  if (t->parallax_rad < cfg.min_parallax_deg * kPi / 180) return {std::nullopt, "low parallax"};
+  if (t->parallax_rad < cfg.min_parallax_deg * kPi / 180) return {std::nullopt, kLowParallax};
   if (!(t->reprojection_px <= cfg.max_reprojection_px)) return {std::nullopt, "reprojection"};
 
   // eq. 52: P_new = J diag(P, R) J^T with J = [d/dx_c^a, d/dx_c^b | d/d(uv_a, uv_b)].
@@ -163,6 +165,40 @@ InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& c
   pixel_cov(5, 5) = cfg.sigma_rho * cfg.sigma_rho;  // the depth prior, independent of the state
   const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
   return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
+}
+
+InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, const CameraRig& commanded_a,
+                                                 const Eigen::Vector2d& uv_a, int cam_b,
+                                                 const CameraRig& commanded_b,
+                                                 const Eigen::Vector2d& uv_b,
+                                                 const InverseDepthInitSettings& cfg,
+                                                 double gate_probability) {
+  InitOutcome r = initialise_inverse_depth(s, cam_a, commanded_a, uv_a, cfg);
+  if (!r.id) return r;
+  const LandmarkSlot* lm = s.find(*r.id);
+  const int rho = lm->offset + 5;
+  // One iterated-EKF step: camera b's projection is linearised at the pair's triangulated inverse
+  // depth rather than at the prior's, whose pixel can be tens of pixels off; the prior mean stays
+  // (the innovation is taken as z - h(x_t) - H (x - x_t)), so the pixel is not counted twice.
+  double rho_lin = s.x(rho);
+  const CameraRig rig_a = estimated_rig(s.x, s.gimbal(cam_a), commanded_a);
+  const CameraRig rig_b = estimated_rig(s.x, s.gimbal(cam_b), commanded_b);
+  const Eigen::Vector3d x_a = s.x.segment<3>(FilterState::cam_pos(cam_a));
+  if (auto t = triangulate_two_views(rig_a, x_a, uv_a, rig_b, s.x.segment<3>(FilterState::cam_pos(cam_b)), uv_b))
+    if (const double d = (t->point - x_a).norm(); d > 0 && (rig_a.R_CW * (t->point - x_a)).z() > 0)
+      rho_lin = 1.0 / d;
+  const double rho_prior = s.x(rho);
+  s.x(rho) = rho_lin;
+  std::optional<Measurement> m = landmark_measurement(s, *lm, cam_b, commanded_b, uv_b, cfg.sigma_px);
+  s.x(rho) = rho_prior;
+  if (m)
+    for (const auto& b : m->blocks)
+      if (b.col == lm->offset) m->h += b.H.col(5) * (rho_prior - rho_lin);
+  const bool compatible = m && update_with_gated_measurements(s, {*m}, gate_probability).front();
+  lm = s.find(*r.id);
+  if (compatible && s.x(lm->offset + 5) > 0) return r;
+  s.remove_landmark(*r.id);
+  return {std::nullopt, compatible ? "negative depth" : "second view incompatible"};
 }
 
 int convert_linear_landmarks(FilterState& s, int cam, double threshold) {

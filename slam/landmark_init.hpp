@@ -4,6 +4,8 @@
 // is augmented with the covariance of that function of the camera states and both pixels
 // (eq. 52), cross-covariances included.
 // Single-UAV baseline: undelayed inverse-depth initialisation from one pixel (Montiel et al. 2006).
+// A cooperative pair with too little parallax for eq. 52's linearisation can instead become an
+// inverse-depth landmark anchored at the first camera and corrected at once with the second pixel.
 #pragma once
 
 #include <Eigen/Core>
@@ -34,10 +36,14 @@ struct CooperativeInitSettings {
   double sigma_px = 3.0;
   double min_parallax_deg = 3.0;
   double max_reprojection_px = 10.0;
+  // Below min_parallax_deg: an inverse-depth landmark from the pair
+  // (initialise_cooperative_inverse_depth) instead of a rejection.
+  bool low_parallax_inverse_depth = false;
 };
 
 // Triangulates, checks depth, parallax and reprojection, and augments the state (eq. 52).
 // Returns the new landmark's id, or the reason it was rejected.
+inline constexpr const char* kLowParallax = "low parallax";
 struct InitOutcome {
   std::optional<LandmarkId> id;
   std::string rejected_because;
@@ -60,6 +66,19 @@ Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x
                                   Eigen::Matrix<double, 6, 5>* J = nullptr);
 InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& commanded,
                                      const Eigen::Vector2d& uv, const InverseDepthInitSettings& cfg);
+
+// A cooperative pair whose parallax is too small for a Euclidean landmark (eq. 52 linearises the
+// triangulation, which is poor at low parallax): the inverse-depth landmark of camera a's pixel,
+// then an EKF update with camera b's pixel of the same instant. Inverse depth keeps that update
+// nearly linear (Montiel et al. 2006), so the second view fixes rho as far as the baseline allows;
+// the update's chi^2 gate (the epipolar test) rejects a pair the landmark cannot explain, and the
+// landmark is then removed again.
+InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, const CameraRig& commanded_a,
+                                                 const Eigen::Vector2d& uv_a, int cam_b,
+                                                 const CameraRig& commanded_b,
+                                                 const Eigen::Vector2d& uv_b,
+                                                 const InverseDepthInitSettings& cfg,
+                                                 double gate_probability);
 
 // Converts inverse-depth landmarks whose linearity index (seen from camera `cam`) is below the
 // threshold; returns how many were converted.

@@ -89,8 +89,8 @@ estimator:
   gating: {probability: 0.99, one_point_ransac: false, ransac_inlier_px: 3,
            ransac_success_probability: 0.95, ransac_max_hypotheses: 50}
   map: {max_landmarks: 200, target_per_camera: 30, max_misses: 7, image_margin_px: 12}
-  initialisation: {min_parallax_deg: 2, max_reprojection_px: 8, inverse_depth_rho: 0.1,
-                   inverse_depth_sigma: 0.05, linearity_threshold: 0.2}
+  initialisation: {min_parallax_deg: 2, max_reprojection_px: 8, low_parallax_inverse_depth: true,
+                   inverse_depth_rho: 0.1, inverse_depth_sigma: 0.05, linearity_threshold: 0.2}
 variants:
   - name: multi
     estimator: {mode: multi}
@@ -164,6 +164,7 @@ TEST(ScenarioYaml, FullDocumentParses) {
   EXPECT_EQ(s.estimator.target_landmarks_per_camera, 30);
   EXPECT_EQ(s.estimator.max_misses, 7);
   EXPECT_DOUBLE_EQ(s.estimator.min_parallax_deg, 2);
+  EXPECT_TRUE(s.estimator.low_parallax_inverse_depth);
   EXPECT_DOUBLE_EQ(s.estimator.linearity_threshold, 0.2);
 
   // The second variant: overrides on top of the base, maps merged key by key.
@@ -335,6 +336,8 @@ estimator:
               HasSubstr("uavs[0].camera.width: must be in [1, 16384], got 0"));
   EXPECT_THAT(error_of("estimator: {initialisation: {min_parallax_deg: 90}}\n"),
               HasSubstr("estimator.initialisation.min_parallax_deg: must be in [0, 90), got 90"));
+  EXPECT_THAT(error_of("estimator: {initialisation: {low_parallax_inverse_depth: 2}}\n"),
+              HasSubstr("expected true or false, got '2'"));
   EXPECT_THAT(error_of("estimator: {map: {max_landmarks: 0}}\n"),
               HasSubstr("estimator.map.max_landmarks: must be >= 1, got 0"));
   EXPECT_THAT(error_of("estimator: {map: {max_misses: 99999999999}}\n"),
