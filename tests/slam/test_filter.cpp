@@ -307,7 +307,7 @@ TEST(Estimator, MapCapEvictsLandmarksOutOfView) {
 }
 
 namespace {
-// Two nadir cameras 3.6 m apart and a ground point far to the side: about 4 degrees of parallax.
+// Two nadir cameras 3.6 m apart and a ground point far to the side: 3.3 degrees of parallax.
 struct LowParallaxPair {
   Eigen::Vector3d p{45.0, 20.0, 0.0};
   static EstimatorSettings settings(bool inverse_depth) {
@@ -347,7 +347,7 @@ TEST(CooperativeInverseDepth, SecondViewFixesTheDepth) {
   ASSERT_TRUE(o[0].id) << o[0].rejected_because;
   const LandmarkSlot* lm = est.state().find(*o[0].id);
   ASSERT_EQ(lm->kind, LandmarkKind::InverseDepth);
-  // The prior alone puts it 20 m from the anchor (rho 0.05); the true distance is about 51 m.
+  // The prior alone puts it 20 m from the anchor (rho 0.05); the true distance is 52.8 m.
   // With noiseless pixels the second view leaves only the prior's pull: a few per cent.
   const double d_true = (pair.p - x_a).norm();
   const double d_est = 1.0 / est.state().x(lm->offset + 5);
