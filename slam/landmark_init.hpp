@@ -41,9 +41,11 @@ struct CooperativeInitSettings {
   bool low_parallax_inverse_depth = false;
 };
 
+// The rejection reason of a pair under min_parallax_deg.
+inline constexpr const char* kLowParallax = "low parallax";
+
 // Triangulates, checks depth, parallax and reprojection, and augments the state (eq. 52).
 // Returns the new landmark's id, or the reason it was rejected.
-inline constexpr const char* kLowParallax = "low parallax";
 struct InitOutcome {
   std::optional<LandmarkId> id;
   std::string rejected_because;
