@@ -123,12 +123,14 @@ RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> ca
 
 void RenderedFrontend::init_cameras() {
   colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
-  // The estimator rejects pairs under its minimum parallax; filtering them before the spread
-  // selection lets it pick among pairs that can be initialised (with a 3 m baseline, most of
-  // the image's outer cells are under 8 degrees and would be chosen, and rejected, every step).
+  // Unless it turns them into inverse-depth landmarks, the estimator rejects pairs under its
+  // minimum parallax; filtering them before the spread selection then lets it pick among pairs
+  // that can be initialised (with a 3 m baseline, most of the image's outer cells are under 8
+  // degrees and would be chosen, and rejected, every step).
   tracking_ = tracking_settings(scn_.frontend);
   cross_ = cross_match_settings(scn_.frontend);
-  cross_.min_parallax_deg = scn_.estimator.min_parallax_deg;
+  cross_.min_parallax_deg =
+      scn_.estimator.low_parallax_inverse_depth ? 0.0 : scn_.estimator.min_parallax_deg;
   for (int u : cam_uav_) {
     Cam c;
     c.model = scn_.uavs[u].camera.camera();
