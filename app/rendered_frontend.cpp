@@ -81,11 +81,17 @@ vision::TrackingSettings tracking_settings(const sim::FrontendSpec& spec) {
   return t;
 }
 
-vision::CrossMatchSettings cross_match_settings(const sim::FrontendSpec& spec) {
+vision::CrossMatchSettings cross_match_settings(const sim::FrontendSpec& spec,
+                                                const sim::EstimatorSpec& estimator) {
   vision::CrossMatchSettings c;
   c.ratio = spec.cross_ratio;
   c.max_epipolar_px = spec.max_epipolar_px;
   c.max_reprojection_px = spec.max_reprojection_px;
+  // Unless it turns them into inverse-depth landmarks, the estimator rejects pairs under its
+  // minimum parallax; filtering them before the spread selection then lets it pick among pairs
+  // that can be initialised (with a 3 m baseline, most of the image's outer cells are under 8
+  // degrees and would be chosen, and rejected, every step).
+  c.min_parallax_deg = estimator.low_parallax_inverse_depth ? 0.0 : estimator.min_parallax_deg;
   c.validate();
   return c;
 }
@@ -123,14 +129,8 @@ RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> ca
 
 void RenderedFrontend::init_cameras() {
   colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
-  // Unless it turns them into inverse-depth landmarks, the estimator rejects pairs under its
-  // minimum parallax; filtering them before the spread selection then lets it pick among pairs
-  // that can be initialised (with a 3 m baseline, most of the image's outer cells are under 8
-  // degrees and would be chosen, and rejected, every step).
   tracking_ = tracking_settings(scn_.frontend);
-  cross_ = cross_match_settings(scn_.frontend);
-  cross_.min_parallax_deg =
-      scn_.estimator.low_parallax_inverse_depth ? 0.0 : scn_.estimator.min_parallax_deg;
+  cross_ = cross_match_settings(scn_.frontend, scn_.estimator);
   for (int u : cam_uav_) {
     Cam c;
     c.model = scn_.uavs[u].camera.camera();

@@ -64,7 +64,9 @@ using FrameSource = std::function<render::Frame(int cam, int k)>;
 // The scenario's `frontend:` section as the vision frontend's settings (validated).
 vision::FeatureSettings feature_settings(const sim::FrontendSpec& spec);
 vision::TrackingSettings tracking_settings(const sim::FrontendSpec& spec);
-vision::CrossMatchSettings cross_match_settings(const sim::FrontendSpec& spec);
+// The cross matcher's minimum parallax comes from the estimator's initialisation settings.
+vision::CrossMatchSettings cross_match_settings(const sim::FrontendSpec& spec,
+                                                const sim::EstimatorSpec& estimator);
 
 class RenderedFrontend {
  public:

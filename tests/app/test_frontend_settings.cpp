@@ -40,10 +40,20 @@ TEST(FrontendSettings, ValuesLandInVisionSettings) {
   EXPECT_DOUBLE_EQ(t.max_distance, 45);
   EXPECT_TRUE(t.match_latest_descriptor);
   EXPECT_FALSE(tracking_settings(sim::FrontendSpec{}).match_latest_descriptor);
-  const vision::CrossMatchSettings c = cross_match_settings(spec);
+  const vision::CrossMatchSettings c = cross_match_settings(spec, scn.front().estimator);
   EXPECT_DOUBLE_EQ(c.ratio, 0.65);
   EXPECT_DOUBLE_EQ(c.max_epipolar_px, 2.5);
   EXPECT_DOUBLE_EQ(c.max_reprojection_px, 1.5);
+}
+
+// Pairs under the estimator's minimum parallax are dropped by the matcher unless the estimator
+// turns them into inverse-depth landmarks, in which case they must reach it.
+TEST(FrontendSettings, CrossMatcherParallaxFollowsTheEstimator) {
+  const auto off = sim::parse_scenarios("estimator: {initialisation: {min_parallax_deg: 8}}\n", "scn.yaml");
+  EXPECT_DOUBLE_EQ(cross_match_settings(off.front().frontend, off.front().estimator).min_parallax_deg, 8);
+  const auto on = sim::parse_scenarios(
+      "estimator: {initialisation: {min_parallax_deg: 8, low_parallax_inverse_depth: true}}\n", "scn.yaml");
+  EXPECT_DOUBLE_EQ(cross_match_settings(on.front().frontend, on.front().estimator).min_parallax_deg, 0);
 }
 
 }  // namespace
