@@ -3,8 +3,10 @@
 
 usage: tools/seed_table.py RESULTS_ROOT VARIANT [VARIANT ...]
 RESULTS_ROOT holds one results directory per seed (seed1/, seed2/, ...), each with one
-subdirectory per variant as `wingman run` writes them. Prints, per variant, Table 4 and Table 5
-totals for every seed and their mean, min and max.
+subdirectory per variant as `wingman run` writes them (the runs/ folder of `wingman montecarlo`
+has that layout). Prints, per variant, Table 4 and Table 5 totals for every seed and their mean,
+min and max; with two or more variants, also on how many seeds the first variant has the lower
+Table 4 total than each other one, per axis and on all six at once.
 """
 import json
 import statistics
@@ -16,9 +18,23 @@ def load(root, variant):
     runs = []
     for d in sorted(Path(root).iterdir(), key=lambda p: (len(p.name), p.name)):
         f = d / variant / "metrics.json"
-        if f.is_file():
+        if d.is_dir() and f.is_file():
             runs.append((d.name, json.loads(f.read_text())))
     return runs
+
+
+def table4_totals(m):
+    t4 = m["table4"]["total"]
+    return t4["lead"]["mse"] + t4["uav1"]["mse"]
+
+
+def paired_counts(root, first, other):
+    """Seeds where `first` has the lower Table 4 total than `other`: per axis, all six, seeds."""
+    a, b = dict(load(root, first)), dict(load(root, other))
+    seeds = [s for s in a if s in b]
+    wins = [[x < y for x, y in zip(table4_totals(a[s]), table4_totals(b[s]))] for s in seeds]
+    per_axis = [sum(col) for col in zip(*wins)] if wins else [0] * 6
+    return per_axis, sum(all(w) for w in wins), len(seeds)
 
 
 def row(name, values):
@@ -48,6 +64,12 @@ def main():
         print(row("**mean**", [statistics.fmean(c) for c in cols]))
         print(row("min", [min(c) for c in cols]))
         print(row("max", [max(c) for c in cols]))
+    for other in variants[1:]:
+        per_axis, all_six, n = paired_counts(root, variants[0], other)
+        print(f"\n#### seeds where {variants[0]} has the lower Table 4 total than {other} (of {n})\n")
+        print("| Xh | Yh | Zh | X1 | Y1 | Z1 | all six |")
+        print("|---" * 7 + "|")
+        print("| " + " | ".join(str(c) for c in per_axis + [all_six]) + " |")
 
 
 if __name__ == "__main__":
