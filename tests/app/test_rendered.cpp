@@ -90,7 +90,7 @@ TEST(RenderedPipeline, SmokeRunMeetsIssueSixTargets) {
   }
   {
     // Bound: 1.5 m at every step and 0.8 m RMS over the run (the lead's GPS alone has sigma
-    // 1.5 m per axis). Measured 0.79 m and 0.40 m (docs/pipeline_rendered.md).
+    // 1.5 m per axis). Measured 0.30 m and 0.18 m (docs/pipeline_rendered.md).
     SCOPED_TRACE("the lead's position error stays under 1.5 m");
     double worst = 0;
     for (const auto& s : rec.steps)
