@@ -21,6 +21,15 @@ Eigen::MatrixXd random_spd(int n, std::mt19937_64& rng) {
   for (int i = 0; i < A.size(); ++i) A.data()[i] = g(rng);
   return A * A.transpose() / n + 0.1 * Eigen::MatrixXd::Identity(n, n);
 }
+// A random mean and a random symmetric positive semi-definite P, so that a prediction's every
+// block is exercised.
+void randomise_state(FilterState& s, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n;
+  const Eigen::MatrixXd A = Eigen::MatrixXd::NullaryExpr(s.dim(), s.dim(), [&] { return n(rng); });
+  s.P = A * A.transpose();
+  s.x = Eigen::VectorXd::NullaryExpr(s.dim(), [&] { return n(rng); });
+}
 CameraRig nadir_rig() {
   CameraRig r;
   r.R_CW = geometry::nadir_R_CW();
@@ -67,11 +76,7 @@ TEST(Prediction, EqualsDenseAPAtPlusQ) {
 // measurement their variance tends to the stationary sigma^2.
 TEST(Prediction, GimbalErrorIsGaussMarkov) {
   FilterState s(2, true);
-  std::mt19937 rng(3);
-  std::normal_distribution<double> n;
-  const Eigen::MatrixXd A = Eigen::MatrixXd::NullaryExpr(s.dim(), s.dim(), [&] { return n(rng); });
-  s.P = A * A.transpose();
-  s.x = Eigen::VectorXd::NullaryExpr(s.dim(), [&] { return n(rng); });
+  randomise_state(s, 3);
   const double dt = 0.1, sigma = 0.04, tau = 5;
   const double phi = std::exp(-dt / tau);
   Eigen::MatrixXd F = Eigen::MatrixXd::Identity(s.dim(), s.dim());
@@ -102,11 +107,7 @@ TEST(Prediction, CommonAccelerationIsSingerForEveryAgent) {
   ASSERT_EQ(s.agent_dim(), s.kinematic_dim() + 4 + 3);
   s.add_landmark(LandmarkKind::Euclidean, Eigen::Vector3d(1, 2, 0), Eigen::MatrixXd::Zero(3, s.dim()),
                  Eigen::Matrix3d::Identity());
-  std::mt19937 rng(4);
-  std::normal_distribution<double> n;
-  const Eigen::MatrixXd A = Eigen::MatrixXd::NullaryExpr(s.dim(), s.dim(), [&] { return n(rng); });
-  s.P = A * A.transpose();
-  s.x = Eigen::VectorXd::NullaryExpr(s.dim(), [&] { return n(rng); });
+  randomise_state(s, 4);
   const double dt = 0.1, sigma = 0.05, tau = 60;
   const double phi = std::exp(-dt / tau);
   const int a = s.common_acceleration();
