@@ -18,7 +18,7 @@ def load(root, variant):
     runs = []
     for d in sorted(Path(root).iterdir(), key=lambda p: (len(p.name), p.name)):
         f = d / variant / "metrics.json"
-        if d.is_dir() and f.is_file():
+        if f.is_file():
             runs.append((d.name, json.loads(f.read_text())))
     return runs
 
@@ -28,9 +28,9 @@ def table4_totals(m):
     return t4["lead"]["mse"] + t4["uav1"]["mse"]
 
 
-def paired_counts(root, first, other):
-    """Seeds where `first` has the lower Table 4 total than `other`: per axis, all six, seeds."""
-    a, b = dict(load(root, first)), dict(load(root, other))
+def paired_counts(first_runs, other_runs):
+    """Seeds where the first variant has the lower Table 4 total: per axis, all six, seeds."""
+    a, b = dict(first_runs), dict(other_runs)
     seeds = [s for s in a if s in b]
     wins = [[x < y for x, y in zip(table4_totals(a[s]), table4_totals(b[s]))] for s in seeds]
     per_axis = [sum(col) for col in zip(*wins)] if wins else [0] * 6
@@ -45,8 +45,9 @@ def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
     root, variants = sys.argv[1], sys.argv[2:]
+    loaded = {}
     for variant in variants:
-        runs = load(root, variant)
+        runs = loaded[variant] = load(root, variant)
         if not runs:
             sys.exit(f"no {variant}/metrics.json under {root}")
         print(f"\n#### {variant}: Table 4 totals (MSE, m²) and Table 5 totals over {len(runs)} seeds\n")
@@ -54,9 +55,8 @@ def main():
         print("|---" * 13 + "|")
         table = []
         for name, m in runs:
-            t4 = m["table4"]["total"]
             t5 = m["table5"]["total"]
-            vals = t4["lead"]["mse"] + t4["uav1"]["mse"] + t5["final_mse"] + t5["init_mse"]
+            vals = table4_totals(m) + t5["final_mse"] + t5["init_mse"]
             vals = [float("nan") if v is None else v for v in vals]
             table.append(vals)
             print(row(name, vals))
@@ -65,7 +65,7 @@ def main():
         print(row("min", [min(c) for c in cols]))
         print(row("max", [max(c) for c in cols]))
     for other in variants[1:]:
-        per_axis, all_six, n = paired_counts(root, variants[0], other)
+        per_axis, all_six, n = paired_counts(loaded[variants[0]], loaded[other])
         print(f"\n#### seeds where {variants[0]} has the lower Table 4 total than {other} (of {n})\n")
         print("| Xh | Yh | Zh | X1 | Y1 | Z1 | all six |")
         print("|---" * 7 + "|")
