@@ -37,11 +37,12 @@ const char* to_string(MeasurementMode m);
 
 // Lead trajectory of eq. 66, shifted so that it starts at `initial_position`.
 struct LeadTrajectorySpec {
-  std::string type = "lemniscate";
+  std::string type = "lemniscate";  // or "line": constant velocity
   double scale = 100.0;      // m
   double omega = 0.015;      // rad/s, of the planar lemniscate
   double z_amplitude = 2.0;  // m
   double z_omega = 0.03;     // rad/s
+  Eigen::Vector3d velocity{1.5, 0, 0};  // m/s, of the line
 };
 
 struct LeadSpec {
@@ -85,6 +86,14 @@ struct NoiseSpec {
   // with phi drawn per camera and axis from the seed, so that Monte Carlo runs see independent
   // gimbal errors, as the filter's model assumes, instead of one realisation every run.
   bool gimbal_random_phase = false;
+  // Random acceleration the true agents carry on top of their curve, drawn per step from the
+  // filter's own process model (eq. 34: v += a dt; agent i's a = a_common + a_i), so that a
+  // Monte Carlo NEES test meets its premise: a truth that realises the noise the filter assumes.
+  // All zero (the paper's deterministic eq. 66) by default.
+  struct Motion {
+    double accel_sigma_lead = 0, accel_sigma_uav = 0, accel_sigma_common = 0;  // m/s^2
+    bool any() const { return accel_sigma_lead > 0 || accel_sigma_uav > 0 || accel_sigma_common > 0; }
+  } motion;
 };
 
 // Static 3D points scattered over the ground below the flight (synthetic mode).

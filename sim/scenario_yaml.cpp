@@ -373,7 +373,7 @@ void parse_noise(const Ctx& ctx, const Field& f, NoiseSpec& n) {
   MapView m(ctx, f,
             {"pixel_sigma", "gps_sigma", "altimeter_sigma", "range_sigma", "ahrs_yaw_sigma",
              "outlier_fraction", "cooperative_outlier_fraction", "outlier_max_px",
-             "gimbal_amplitude", "gimbal_omega", "gimbal_random_phase"});
+             "gimbal_amplitude", "gimbal_omega", "gimbal_random_phase", "motion"});
   num(ctx, m, "pixel_sigma", n.pixel_sigma, ge(0));
   num(ctx, m, "gps_sigma", n.gps_sigma, ge(0));
   num(ctx, m, "altimeter_sigma", n.altimeter_sigma, ge(0));
@@ -385,6 +385,12 @@ void parse_noise(const Ctx& ctx, const Field& f, NoiseSpec& n) {
   num(ctx, m, "gimbal_amplitude", n.gimbal_amplitude);
   num(ctx, m, "gimbal_omega", n.gimbal_omega);
   boolean(ctx, m, "gimbal_random_phase", n.gimbal_random_phase);
+  if (auto f = m.get("motion")) {
+    MapView mm(ctx, *f, {"accel_sigma_lead", "accel_sigma_uav", "accel_sigma_common"});
+    num(ctx, mm, "accel_sigma_lead", n.motion.accel_sigma_lead, ge(0));
+    num(ctx, mm, "accel_sigma_uav", n.motion.accel_sigma_uav, ge(0));
+    num(ctx, mm, "accel_sigma_common", n.motion.accel_sigma_common, ge(0));
+  }
 }
 
 void parse_landmarks(const Ctx& ctx, const Field& f, LandmarkFieldSpec& l) {
@@ -396,14 +402,15 @@ void parse_landmarks(const Ctx& ctx, const Field& f, LandmarkFieldSpec& l) {
 }
 
 void parse_trajectory(const Ctx& ctx, const Field& f, LeadTrajectorySpec& t) {
-  MapView m(ctx, f, {"type", "scale", "omega", "z_amplitude", "z_omega"});
+  MapView m(ctx, f, {"type", "scale", "omega", "z_amplitude", "z_omega", "velocity"});
   if (auto tf = m.get("type")) {
     const std::string s = read_string(ctx, *tf);
-    if (s != "lemniscate")
+    if (s != "lemniscate" && s != "line")
       ctx.fail(tf->loc(),
-               fmt::format("unknown trajectory type '{}' (the only one is 'lemniscate')", s));
+               fmt::format("unknown trajectory type '{}' (known: 'lemniscate', 'line')", s));
     t.type = s;
   }
+  set_if(m, "velocity", t.velocity, [&](const Field& x) { return read_vec3(ctx, x); });
   num(ctx, m, "scale", t.scale);
   num(ctx, m, "omega", t.omega);
   num(ctx, m, "z_amplitude", t.z_amplitude);

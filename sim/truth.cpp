@@ -1,5 +1,6 @@
 #include "sim/truth.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "geometry/rotation.hpp"
@@ -20,18 +21,63 @@ KinematicState lemniscate(const LeadTrajectorySpec& p, double t) {
   return k;
 }
 
+KinematicState nominal_motion(const LeadTrajectorySpec& p, double t) {
+  if (p.type == "line") return {p.velocity * t, p.velocity};
+  return lemniscate(p, t);
+}
+
 OpenLoopTruth::OpenLoopTruth(const Scenario& scn)
-    : Truth(scn), origin_(lemniscate(scn.lead.trajectory, 0).position) {}
+    : Truth(scn), origin_(nominal_motion(scn.lead.trajectory, 0).position) {
+  const auto& m = scn.noise.motion;
+  if (!m.any() || scn.num_steps() < 1) return;
+  // The filter's discrete model (slam/motion_model.hpp): p += v dt, then v += a dt, with one
+  // acceleration shared by every agent plus each agent's own.
+  const std::size_t agents = 1 + scn.uavs.size();
+  const int n = scn.num_steps();
+  const double dt = scn.dt();
+  wander_.assign(agents, std::vector<KinematicState>(static_cast<std::size_t>(n) + 1));
+  std::mt19937_64 rng = make_stream(scn.seed, "motion");
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  auto draw = [&](double sigma) {  // one draw per axis, in order, so a seed means one path
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i) v(i) = sigma * gauss(rng);
+    return v;
+  };
+  for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
+    const Eigen::Vector3d common = draw(m.accel_sigma_common);
+    for (std::size_t a = 0; a < agents; ++a) {
+      const Eigen::Vector3d acc = common + draw(a == 0 ? m.accel_sigma_lead : m.accel_sigma_uav);
+      const KinematicState& now = wander_[a][k];
+      KinematicState& next = wander_[a][k + 1];
+      next.position = now.position + now.velocity * dt;
+      next.velocity = now.velocity + acc * dt;
+    }
+  }
+}
+
+KinematicState OpenLoopTruth::wander(std::size_t a, double t) const {
+  if (wander_.empty()) return {};
+  const auto& w = wander_[a];
+  const double s = std::clamp(t / scn_.dt(), 0.0, static_cast<double>(w.size() - 1));
+  const auto k = std::min(static_cast<std::size_t>(s), w.size() - 2);
+  const double f = s - static_cast<double>(k);
+  return {(1 - f) * w[k].position + f * w[k + 1].position,
+          (1 - f) * w[k].velocity + f * w[k + 1].velocity};
+}
 
 KinematicState OpenLoopTruth::lead(double t) const {
-  KinematicState k = lemniscate(scn_.lead.trajectory, t);
-  k.position += scn_.lead.initial_position - origin_;
+  KinematicState k = nominal_motion(scn_.lead.trajectory, t);
+  const KinematicState d = wander(0, t);
+  k.position += scn_.lead.initial_position - origin_ + d.position;
+  k.velocity += d.velocity;
   return k;
 }
 
 KinematicState OpenLoopTruth::uav(int j, double t) const {
-  KinematicState k = lemniscate(scn_.lead.trajectory, t);
-  k.position += scn_.uavs[j].initial_position - origin_;
+  KinematicState k = nominal_motion(scn_.lead.trajectory, t);
+  const KinematicState d = wander(1 + static_cast<std::size_t>(j), t);
+  k.position += scn_.uavs[j].initial_position - origin_ + d.position;
+  k.velocity += d.velocity;
   return k;
 }
 

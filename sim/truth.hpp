@@ -1,5 +1,6 @@
-// Ground-truth motion of the open-loop runs: the lead follows the lemniscate of paper eq. 66 and
-// every UAV the same curve shifted by its initial offset (DESIGN.md §3); the cameras carry the
+// Ground-truth motion of the open-loop runs: the lead follows the lemniscate of paper eq. 66 (or a
+// straight line) and every UAV the same curve shifted by its initial offset (DESIGN.md §3), each
+// agent plus the random acceleration of noise.motion when the scenario asks for it; the cameras carry the
 // gimbal error e_r(t) = A sin(w t) about their x and y axes (or with a phase per camera and
 // axis, noise.gimbal_random_phase), which the filter never sees.
 // Truth is the interface the synthetic source reads; closed_loop_truth.hpp is the other one.
@@ -19,6 +20,8 @@ struct KinematicState {
 
 // eq. 66 and its time derivative, unshifted.
 KinematicState lemniscate(const LeadTrajectorySpec& spec, double t);
+// The curve the scenario names (lemniscate or line), unshifted.
+KinematicState nominal_motion(const LeadTrajectorySpec& spec, double t);
 
 // What the synthetic measurements are made from: the lead, the UAVs and their cameras. The
 // open-loop truth knows every instant in advance; the closed-loop one only the current step.
@@ -54,7 +57,13 @@ class OpenLoopTruth : public Truth {
   Eigen::Vector4d horizontal_extent() const override;
 
  private:
+  // Agent a's (0: lead, 1 + j: UAV j) deviation from its curve at t, interpolated between steps.
+  KinematicState wander(std::size_t a, double t) const;
+
   Eigen::Vector3d origin_;  // the curve's value at t = 0
+  // Per agent, per step k = 0..num_steps: the integrated noise.motion acceleration; empty when
+  // the scenario has none.
+  std::vector<std::vector<KinematicState>> wander_;
 };
 
 }  // namespace wingman::sim

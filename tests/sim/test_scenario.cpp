@@ -312,6 +312,23 @@ uavs:
               HasSubstr("scn.yaml:1:15: measurements: unknown measurement mode 'photos'"));
   EXPECT_THAT(error_of("lead: {trajectory: {type: circle}}\n"),
               HasSubstr("lead.trajectory.type: unknown trajectory type 'circle'"));
+  EXPECT_THAT(error_of("noise: {motion: {accel_sigma_lead: -0.1}}\n"),
+              HasSubstr("noise.motion.accel_sigma_lead: must be >= 0, got -0.1"));
+  EXPECT_THAT(error_of("noise: {motion: {accel_sigma: 0.1}}\n"),
+              HasSubstr("scn.yaml:1:18: noise.motion.accel_sigma: unknown key 'accel_sigma'"));
+}
+
+TEST(ScenarioYaml, LineTrajectoryAndTruthMotionNoise) {
+  const Scenario s = parse_scenarios(
+      "lead: {trajectory: {type: line, velocity: [1, 2, 0]}}\n"
+      "noise: {motion: {accel_sigma_lead: 0.01, accel_sigma_uav: 0.02, accel_sigma_common: 0.03}}\n",
+      "x.yaml")[0];
+  EXPECT_EQ(s.lead.trajectory.type, "line");
+  EXPECT_EQ(s.lead.trajectory.velocity, Eigen::Vector3d(1, 2, 0));
+  EXPECT_EQ(s.noise.motion.accel_sigma_lead, 0.01);
+  EXPECT_EQ(s.noise.motion.accel_sigma_uav, 0.02);
+  EXPECT_EQ(s.noise.motion.accel_sigma_common, 0.03);
+  EXPECT_FALSE(parse_scenarios("seed: 1\n", "x.yaml")[0].noise.motion.any());
 }
 
 TEST(ScenarioYaml, ValuesOutOfRange) {
