@@ -10,6 +10,7 @@
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <random>
 #include <thread>
 
 #include "app/rendered_frontend.hpp"
@@ -18,6 +19,7 @@
 #include "control/formation.hpp"
 #include "control/sliding_mode.hpp"
 #include "sim/closed_loop_truth.hpp"
+#include "sim/rng.hpp"
 #include "sim/synthetic_source.hpp"
 #include "sim/truth.hpp"
 #include "slam/estimator.hpp"
@@ -126,6 +128,16 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   if (fe && !ro.video.empty()) fe->open_video(ro.video);
   if (fe) fe->set_prefetch(prefetch);
 
+  // The filter's initial estimate: the truth, or the truth plus a draw of the initial covariance.
+  std::mt19937_64 init_rng = sim::make_stream(scn.seed, "initial_estimate");
+  std::normal_distribution<double> init_gauss(0.0, 1.0);
+  auto initial_estimate = [&](const sim::KinematicState& k) {
+    slam::AgentInit a{k.position, k.velocity};
+    if (!scn.estimator.draw_initial_error) return a;
+    for (int i = 0; i < 3; ++i) a.position(i) += scn.estimator.initial_position_sigma * init_gauss(init_rng);
+    for (int i = 0; i < 3; ++i) a.velocity(i) += scn.estimator.initial_velocity_sigma * init_gauss(init_rng);
+    return a;
+  };
   std::vector<slam::CameraRig> rigs;
   std::vector<slam::AgentInit> cam_init;
   for (int u : cam_uav) {
@@ -135,11 +147,10 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     rig.offset = scn.uavs[u].camera.offset;
     rig.orientation_sigma = scn.estimator.orientation_sigma;
     rigs.push_back(rig);
-    const auto c = truth.camera(u, 0.0);
-    cam_init.push_back({c.position, c.velocity});
+    cam_init.push_back(initial_estimate(truth.camera(u, 0.0)));
   }
-  const auto lead0 = truth.lead(0.0);
-  slam::Estimator est(rigs, {lead0.position, lead0.velocity}, cam_init, estimator_settings(scn));
+  const slam::AgentInit lead0 = initial_estimate(truth.lead(0.0));
+  slam::Estimator est(rigs, lead0, cam_init, estimator_settings(scn));
 
   eval::RunRecord rec;
   rec.scenario_path = scn.source_path;

@@ -595,9 +595,10 @@ void parse_estimator(const Ctx& ctx, const Field& f, EstimatorSpec& e, Provenanc
     num(ctx, r, "orientation_time_constant", e.orientation_time_constant, ge(0));
   }
   if (auto inf = m.get("initial_sigma")) {
-    MapView s(ctx, *inf, {"position", "velocity"});
+    MapView s(ctx, *inf, {"position", "velocity", "draw"});
     num(ctx, s, "position", e.initial_position_sigma, ge(0));
     num(ctx, s, "velocity", e.initial_velocity_sigma, ge(0));
+    boolean(ctx, s, "draw", e.draw_initial_error);
   }
   if (auto gf = m.get("gating")) {
     MapView g(ctx, *gf,

@@ -329,6 +329,9 @@ TEST(ScenarioYaml, LineTrajectoryAndTruthMotionNoise) {
   EXPECT_EQ(s.noise.motion.accel_sigma_uav, 0.02);
   EXPECT_EQ(s.noise.motion.accel_sigma_common, 0.03);
   EXPECT_FALSE(parse_scenarios("seed: 1\n", "x.yaml")[0].noise.motion.any());
+  EXPECT_FALSE(parse_scenarios("seed: 1\n", "x.yaml")[0].estimator.draw_initial_error);
+  EXPECT_TRUE(parse_scenarios("estimator: {initial_sigma: {position: 0.5, draw: true}}\n", "x.yaml")[0]
+                  .estimator.draw_initial_error);
 }
 
 TEST(ScenarioYaml, ValuesOutOfRange) {
