@@ -9,8 +9,8 @@
 #include <map>
 #include <memory>
 #include <opencv2/imgproc.hpp>
-#include <stdexcept>
 #include <random>
+#include <stdexcept>
 #include <thread>
 
 #include "app/rendered_frontend.hpp"
