@@ -86,7 +86,8 @@ TEST(Truth, MotionNoiseFollowsTheFiltersProcessModel) {
   Scenario scn = parse_scenarios("duration: 400\nseed: 9\n", "inline.yaml").front();
   scn.noise.motion = {0.02, 0.04, 0.03};  // lead, uav, common
   const OpenLoopTruth truth(scn), again(scn);
-  const OpenLoopTruth nominal(paper_scenario());
+  const Scenario paper = paper_scenario();  // Truth keeps a reference: the scenario must outlive it
+  const OpenLoopTruth nominal(paper);
   const double dt = scn.dt();
   const int n = scn.num_steps();
   double var_lead = 0, var_uav = 0, cov_uavs = 0, cov_lead_uav = 0;
