@@ -55,30 +55,26 @@ OpenLoopTruth::OpenLoopTruth(const Scenario& scn)
   }
 }
 
-KinematicState OpenLoopTruth::wander(std::size_t a, double t) const {
-  if (wander_.empty()) return {};
+KinematicState OpenLoopTruth::agent(std::size_t a, const Eigen::Vector3d& start, double t) const {
+  KinematicState k = nominal_motion(scn_.lead.trajectory, t);
+  if (wander_.empty()) {
+    k.position += start - origin_;
+    return k;
+  }
+  // The deviation, interpolated between steps.
   const auto& w = wander_[a];
   const double s = std::clamp(t / scn_.dt(), 0.0, static_cast<double>(w.size() - 1));
-  const auto k = std::min(static_cast<std::size_t>(s), w.size() - 2);
-  const double f = s - static_cast<double>(k);
-  return {(1 - f) * w[k].position + f * w[k + 1].position,
-          (1 - f) * w[k].velocity + f * w[k + 1].velocity};
-}
-
-KinematicState OpenLoopTruth::lead(double t) const {
-  KinematicState k = nominal_motion(scn_.lead.trajectory, t);
-  const KinematicState d = wander(0, t);
-  k.position += scn_.lead.initial_position - origin_ + d.position;
-  k.velocity += d.velocity;
+  const auto i = std::min(static_cast<std::size_t>(s), w.size() - 2);
+  const double f = s - static_cast<double>(i);
+  k.position += start - origin_ + ((1 - f) * w[i].position + f * w[i + 1].position);
+  k.velocity += (1 - f) * w[i].velocity + f * w[i + 1].velocity;
   return k;
 }
+
+KinematicState OpenLoopTruth::lead(double t) const { return agent(0, scn_.lead.initial_position, t); }
 
 KinematicState OpenLoopTruth::uav(int j, double t) const {
-  KinematicState k = nominal_motion(scn_.lead.trajectory, t);
-  const KinematicState d = wander(1 + static_cast<std::size_t>(j), t);
-  k.position += scn_.uavs[j].initial_position - origin_ + d.position;
-  k.velocity += d.velocity;
-  return k;
+  return agent(1 + static_cast<std::size_t>(j), scn_.uavs[j].initial_position, t);
 }
 
 KinematicState Truth::camera(int j, double t) const {

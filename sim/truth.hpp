@@ -57,8 +57,8 @@ class OpenLoopTruth : public Truth {
   Eigen::Vector4d horizontal_extent() const override;
 
  private:
-  // Agent a's (0: lead, 1 + j: UAV j) deviation from its curve at t, interpolated between steps.
-  KinematicState wander(std::size_t a, double t) const;
+  // Agent a (0: lead, 1 + j: UAV j): the curve shifted to start at `start`, plus its deviation.
+  KinematicState agent(std::size_t a, const Eigen::Vector3d& start, double t) const;
 
   Eigen::Vector3d origin_;  // the curve's value at t = 0
   // Per agent, per step k = 0..num_steps: the integrated noise.motion acceleration; empty when
