@@ -130,12 +130,12 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
 
   // The filter's initial estimate: the truth, or the truth plus a draw of the initial covariance.
   std::mt19937_64 init_rng = sim::make_stream(scn.seed, "initial_estimate");
-  std::normal_distribution<double> init_gauss(0.0, 1.0);
+  std::normal_distribution<double> unit(0.0, 1.0);
   auto initial_estimate = [&](const sim::KinematicState& k) {
     slam::AgentInit a{k.position, k.velocity};
     if (!scn.estimator.draw_initial_error) return a;
-    for (int i = 0; i < 3; ++i) a.position(i) += scn.estimator.initial_position_sigma * init_gauss(init_rng);
-    for (int i = 0; i < 3; ++i) a.velocity(i) += scn.estimator.initial_velocity_sigma * init_gauss(init_rng);
+    a.position += sim::gaussian3(init_rng, unit, scn.estimator.initial_position_sigma);
+    a.velocity += sim::gaussian3(init_rng, unit, scn.estimator.initial_velocity_sigma);
     return a;
   };
   std::vector<slam::CameraRig> rigs;

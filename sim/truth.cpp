@@ -37,16 +37,11 @@ OpenLoopTruth::OpenLoopTruth(const Scenario& scn)
   const double dt = scn.dt();
   wander_.assign(agents, std::vector<KinematicState>(static_cast<std::size_t>(n) + 1));
   std::mt19937_64 rng = make_stream(scn.seed, "motion");
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  auto draw = [&](double sigma) {  // one draw per axis, in order, so a seed means one path
-    Eigen::Vector3d v;
-    for (int i = 0; i < 3; ++i) v(i) = sigma * gauss(rng);
-    return v;
-  };
+  std::normal_distribution<double> unit(0.0, 1.0);
   for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
-    const Eigen::Vector3d common = draw(m.accel_sigma_common);
+    const Eigen::Vector3d common = gaussian3(rng, unit, m.accel_sigma_common);
     for (std::size_t a = 0; a < agents; ++a) {
-      const Eigen::Vector3d acc = common + draw(a == 0 ? m.accel_sigma_lead : m.accel_sigma_uav);
+      const Eigen::Vector3d acc = common + gaussian3(rng, unit, a == 0 ? m.accel_sigma_lead : m.accel_sigma_uav);
       const KinematicState& now = wander_[a][k];
       KinematicState& next = wander_[a][k + 1];
       next.position = now.position + now.velocity * dt;
