@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "eval/nees_null.hpp"
 #include "geometry/chi2.hpp"
 
 namespace wingman::eval {
@@ -54,6 +55,39 @@ std::vector<double> read_times(const fs::path& path) {
 
 double number_or_nan(const json& j) { return j.is_number() ? j.get<double>() : kNaN; }
 
+// What an exactly consistent filter would show (eval/nees_null.hpp), from the runs' NEES
+// autocorrelation over the steps where every run has one. Lags up to 30 s (a third of the run at
+// most) feed the AR model; 2000 simulated batches with a fixed seed, so the figures repeat.
+void consistent_filter_inside(MonteCarloSummary& m, const std::vector<std::vector<double>>& per_run,
+                              std::vector<MonteCarloPhase>& phases,
+                              const std::vector<std::vector<std::size_t>>& phase_steps) {
+  const std::size_t steps = m.t.size();
+  std::size_t first = steps, last = 0;
+  for (std::size_t k = 0; k < steps; ++k)
+    if (std::isfinite(m.average_nees[k])) first = std::min(first, k), last = k + 1;
+  if (per_run.size() < 2 || last < first + 10) return;
+  for (std::size_t k = first; k < last; ++k)
+    if (!std::isfinite(m.average_nees[k])) return;  // a gap: the series is not one process
+  const double dt = (m.t[last - 1] - m.t[first]) / static_cast<double>(last - 1 - first);
+  const std::size_t max_lag =
+      std::min<std::size_t>((last - first) / 3, dt > 0 ? static_cast<std::size_t>(std::lround(60.0 / dt)) : 0);
+  const std::vector<double> acf = nees_autocorrelation(per_run, first, last, max_lag);
+  m.nees_correlation_time = integrated_correlation_steps(acf) * dt;
+  std::vector<std::vector<std::size_t>> ranges;
+  for (const auto& idx : phase_steps) {
+    ranges.emplace_back();
+    for (std::size_t k : idx) ranges.back().push_back(k - first);
+  }
+  // "Every phase" leaves out the last range, "total".
+  const auto sim = simulate_consistent_inside(fit_autoregression(acf), last - first, ranges,
+                                              ranges.size() - 1, kInsideTarget, 2000, 1);
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    phases[i].consistent_median_inside = sim.median[i];
+    phases[i].consistent_p_below_target = sim.p_below[i];
+  }
+  m.consistent_p_all_phases_at_target = sim.p_all_at_target;
+}
+
 }  // namespace
 
 Spread spread_of(const std::vector<double>& values) {
@@ -73,6 +107,11 @@ Spread spread_of(const std::vector<double>& values) {
   return s;
 }
 
+double mean_nees_halfwidth95(const Spread& run_means) {
+  if (run_means.n < 2) return kNaN;
+  return 1.959963984540054 * run_means.std / std::sqrt(static_cast<double>(run_means.n));
+}
+
 MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs::path>& run_dirs) {
   if (run_dirs.empty()) throw std::runtime_error(fmt::format("{}: no finished runs", label));
   MonteCarloSummary m;
@@ -86,6 +125,7 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
   // Average NEES per step over the runs that have it (none at k = 0, before any update).
   std::vector<double> sum(steps, 0.0);
   std::vector<int> count(steps, 0);
+  std::vector<std::vector<double>> per_run(metrics.size(), std::vector<double>(steps, kNaN));
   for (std::size_t r = 0; r < metrics.size(); ++r) {
     const auto& nees = metrics[r].at("nees");
     const auto& per_step = nees.at("per_step");
@@ -99,7 +139,8 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
       throw std::runtime_error(fmt::format("{}: NEES over {} dof, the first run has {}",
                                            (run_dirs[r] / "metrics.json").string(), dof, m.dof));
     for (std::size_t k = 0; k < steps; ++k)
-      if (const double v = number_or_nan(per_step[k]); std::isfinite(v)) sum[k] += v, ++count[k];
+      if (const double v = number_or_nan(per_step[k]); std::isfinite(v))
+        sum[k] += v, ++count[k], per_run[r][k] = v;
   }
   m.average_nees.assign(steps, kNaN);
   for (std::size_t k = 0; k < steps; ++k)
@@ -123,8 +164,12 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
   total.name = "total";
   total.t_start = m.t.empty() ? 0 : m.t.front();
   total.t_end = m.t.empty() ? 0 : m.t.back();
+  // Step indices of each phase with an average NEES, for the consistent-filter simulation.
+  std::vector<std::vector<std::size_t>> phase_steps;
   auto bounds_count = [&](MonteCarloPhase& ph, bool whole) {
     double nees_sum = 0;
+    std::vector<std::size_t> indices;
+    std::vector<double> run_sum(per_run.size(), 0.0);
     for (std::size_t k = 0; k < steps; ++k) {
       const double v = m.average_nees[k];
       if (!std::isfinite(v)) continue;
@@ -134,11 +179,16 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
       ++ph.steps;
       nees_sum += v;
       if (v >= m.lower && v <= m.upper) ++ph.inside;
+      indices.push_back(k);
+      for (std::size_t r = 0; r < per_run.size(); ++r) run_sum[r] += per_run[r][k];
     }
     if (ph.steps > 0) {
       ph.fraction_inside = static_cast<double>(ph.inside) / ph.steps;
       ph.mean_nees = nees_sum / ph.steps;
+      for (double& x : run_sum) x /= ph.steps;
+      ph.run_mean_nees = spread_of(run_sum);
     }
+    phase_steps.push_back(std::move(indices));
   };
   // Table 4 spreads; `pick` finds the agents' object: table4.phases[i].agents or table4.total.
   auto table4_spread = [&](MonteCarloPhase& ph, const json* (*pick)(const json&, std::size_t),
@@ -193,6 +243,7 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
     return &mj.at("table4").at("total");
   }, 0);
   phases.push_back(total);
+  consistent_filter_inside(m, per_run, phases, phase_steps);
   m.phases = std::move(phases);
   return m;
 }
@@ -205,6 +256,9 @@ void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs
     j["runs"] = m.runs;
     j["nees_dof"] = m.dof;
     j["nees_bounds"] = {m.lower, m.upper};
+    j["nees_correlation_time_s"] = m.nees_correlation_time;
+    j["consistent_filter_p_all_phases_inside_target"] = m.consistent_p_all_phases_at_target;
+    j["inside_target"] = kInsideTarget;
     auto spread = [](const Spread& s) {
       return json{{"mean", s.mean}, {"std", s.std}, {"min", s.min}, {"max", s.max}, {"n", s.n}};
     };
@@ -213,6 +267,11 @@ void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs
               {"t_end", p.t_end},       {"nees_steps", p.steps},
               {"nees_inside", p.inside}, {"nees_fraction_inside", p.fraction_inside},
               {"nees_mean", p.mean_nees}};
+      const double hw = mean_nees_halfwidth95(p.run_mean_nees);
+      jp["nees_run_means"] = spread(p.run_mean_nees);
+      jp["nees_mean_ci95"] = {p.run_mean_nees.mean - hw, p.run_mean_nees.mean + hw};
+      jp["consistent_filter"] = {{"median_fraction_inside", p.consistent_median_inside},
+                                 {"p_fraction_below_target", p.consistent_p_below_target}};
       for (const auto& a : p.agents)
         jp["mse"][a.agent] = {spread(a.mse[0]), spread(a.mse[1]), spread(a.mse[2])};
       for (const auto& b : p.blocks)
@@ -257,6 +316,19 @@ std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries) 
         for (const auto& sp : a.mse) s += fmt::format(" {:>7.4f}±{:<7.4f}", sp.mean, sp.std);
       s += "\n";
     }
+    s += fmt::format("consistency (a consistent filter averages {}; its NEES decorrelates over {:.1f} s):\n",
+                     m.dof, m.nees_correlation_time);
+    s += fmt::format("{:<10} {:>8} {:>24} {:>29} {:>16}\n", "phase", "inside", "mean NEES [95% CI]",
+                     "consistent filter: inside", fmt::format("P(< {:.0f}%)", 100 * kInsideTarget));
+    for (const auto& p : m.phases) {
+      const double hw = mean_nees_halfwidth95(p.run_mean_nees);
+      s += fmt::format("{:<10} {:>7.1f}% {:>8.2f} [{:>6.2f}, {:>6.2f}] {:>28.1f}% {:>15.1f}%\n", p.name,
+                       100 * p.fraction_inside, p.run_mean_nees.mean, p.run_mean_nees.mean - hw,
+                       p.run_mean_nees.mean + hw, 100 * p.consistent_median_inside,
+                       100 * p.consistent_p_below_target);
+    }
+    s += fmt::format("a consistent filter puts every phase at >= {:.0f}% inside with probability {:.0f}%\n",
+                     100 * kInsideTarget, 100 * m.consistent_p_all_phases_at_target);
     if (m.phases.front().blocks.empty()) continue;
     s += fmt::format("{:<10}", "NEES/block");
     for (const auto& b : m.phases.front().blocks)

@@ -2,6 +2,9 @@
 // average NEES per step with the two-sided 95 % chi^2 bounds for N runs,
 // [chi2_0.025(dof N) / N, chi2_0.975(dof N) / N], the fraction of steps inside them per phase,
 // and the mean and spread of the Table 4 metrics per phase. Reads what `wingman run` wrote.
+// Because the fraction inside is itself random (eval/nees_null.hpp), each phase also gets the
+// runs' mean NEES with a confidence interval and what an exactly consistent filter with the same
+// error correlation would show.
 #pragma once
 
 #include <filesystem>
@@ -37,9 +40,23 @@ struct MonteCarloPhase {
   int inside = 0;         // of which inside the bounds
   double fraction_inside = kNaN;
   double mean_nees = kNaN;  // average NEES averaged over the phase's steps
+  // Each run's mean NEES over the phase, spread over the runs: runs are independent, so
+  // mean ± 1.96 std / sqrt(runs) is a 95 % interval for the filter's phase mean (normal
+  // approximation), which accounts for the correlation in time that the per-step bounds ignore.
+  Spread run_mean_nees;
+  // An exactly consistent filter with these runs' NEES autocorrelation: the median fraction of
+  // the phase's steps inside the bounds, and the probability of a fraction under kInsideTarget.
+  double consistent_median_inside = kNaN;
+  double consistent_p_below_target = kNaN;
   std::vector<AgentSpread> agents;  // Table 4 of the phase over the runs
   std::vector<BlockNees> blocks;    // phases only (empty for "total" and for older runs)
 };
+
+// The fraction of steps inside the bounds that issue 3 asks of every phase.
+inline constexpr double kInsideTarget = 0.9;
+
+// 95 % half-width of the interval for the phase mean NEES from the runs' phase means.
+double mean_nees_halfwidth95(const Spread& run_means);
 
 struct MonteCarloSummary {
   std::string label;  // the variant, or the scenario name
@@ -48,6 +65,12 @@ struct MonteCarloSummary {
   double lower = kNaN, upper = kNaN;  // bounds of the average NEES
   std::vector<double> t, average_nees;  // per step
   std::vector<MonteCarloPhase> phases;  // every phase, then "total"
+  // Integral time scale of the runs' NEES (s): a phase holds about its length / this many
+  // independent looks at the filter's consistency.
+  double nees_correlation_time = kNaN;
+  // Probability that an exactly consistent filter puts every phase (not "total") at or above
+  // kInsideTarget, with these runs' error correlation.
+  double consistent_p_all_phases_at_target = kNaN;
 };
 
 // Aggregates the results directories of N runs of one variant (each holding metrics.json and

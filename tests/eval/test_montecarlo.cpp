@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
 
 #include "eval/montecarlo.hpp"
 #include "geometry/chi2.hpp"
@@ -120,4 +121,51 @@ TEST(MonteCarlo, RunsWithDifferentStepsAreAnErrorNamingTheFile) {
   }
   std::ofstream(tmp.path / "r2" / "metrics.json") << "{ not json";
   EXPECT_THROW(aggregate_runs("multi", {tmp.path / "r1", tmp.path / "r2"}), std::runtime_error);
+}
+
+TEST(MonteCarlo, PhaseMeanIntervalAndConsistentFilterReferenceFromRuns) {
+  TempDir tmp;
+  // 40 runs of 201 steps at 10 Hz, phases [0, 10) and [10, 20]; NEES ~ chi2(6), white in time:
+  // the interval holds 6 and a consistent filter keeps a phase of 100 steps inside 95 % of them.
+  std::mt19937_64 rng(11);
+  std::chi_squared_distribution<double> chi2(6);
+  std::vector<fs::path> dirs;
+  for (int r = 0; r < 40; ++r) {
+    const fs::path dir = tmp.path / std::to_string(r);
+    fs::create_directories(dir);
+    nlohmann::json m;
+    m["nees"]["dof"] = 6;
+    m["nees"]["per_step"] = nlohmann::json::array({nullptr});
+    for (int k = 1; k <= 200; ++k) m["nees"]["per_step"].push_back(chi2(rng));
+    m["phases"] = {{{"name", "a"}, {"t_start", 0.0}, {"t_end", 10.0}},
+                   {{"name", "b"}, {"t_start", 10.0}, {"t_end", 20.0}}};
+    const auto agents = nlohmann::json{{"lead", {{"mse", {0.1, 0.0, 0.0}}}}};
+    m["table4"]["phases"] = {{{"agents", agents}}, {{"agents", agents}}};
+    m["table4"]["total"] = agents;
+    std::ofstream(dir / "metrics.json") << m.dump();
+    std::ofstream csv(dir / "steps.csv");
+    csv << "k,t\n";
+    for (int k = 0; k <= 200; ++k) csv << k << "," << 0.1 * k << "\n";
+    dirs.push_back(dir);
+  }
+  const MonteCarloSummary m = aggregate_runs("multi", dirs);
+  ASSERT_EQ(m.phases.size(), 3u);
+  for (const auto& p : m.phases) {
+    const double hw = mean_nees_halfwidth95(p.run_mean_nees);
+    EXPECT_EQ(p.run_mean_nees.n, 40);
+    // Each run's phase mean of ~100 chi2(6) has std sqrt(12 / 100); over 40 runs the half-width
+    // is 1.96 * 0.35 / sqrt(40) = 0.11.
+    EXPECT_NEAR(hw, 1.96 * std::sqrt(12.0 / p.steps) / std::sqrt(40.0), 0.04) << p.name;
+    EXPECT_LT(std::abs(p.run_mean_nees.mean - 6.0), 3 * hw) << p.name;
+    EXPECT_NEAR(p.run_mean_nees.mean, p.mean_nees, 1e-9) << p.name;  // same steps, same runs
+    EXPECT_NEAR(p.consistent_median_inside, 0.95, 0.03) << p.name;
+  }
+  EXPECT_NEAR(m.nees_correlation_time, 0.1, 0.1);  // white: one step
+  EXPECT_GT(m.consistent_p_all_phases_at_target, 0.7);
+  const std::string table = format_monte_carlo({m});
+  EXPECT_NE(table.find("mean NEES [95% CI]"), std::string::npos) << table;
+  write_monte_carlo({m}, tmp.path);
+  const auto j = nlohmann::json::parse(std::ifstream(tmp.path / "montecarlo.json"));
+  EXPECT_TRUE(j[0]["phases"][0].contains("nees_mean_ci95"));
+  EXPECT_TRUE(j[0]["phases"][0]["consistent_filter"]["median_fraction_inside"].is_number());
 }
