@@ -56,7 +56,7 @@ std::vector<double> read_times(const fs::path& path) {
 double number_or_nan(const json& j) { return j.is_number() ? j.get<double>() : kNaN; }
 
 // What an exactly consistent filter would show (eval/nees_null.hpp), from the runs' NEES
-// autocorrelation over the steps where every run has one. Lags up to 30 s (a third of the run at
+// autocorrelation over the steps where every run has one. Lags up to 60 s (a third of the run at
 // most) feed the AR model; 2000 simulated batches with a fixed seed, so the figures repeat.
 void consistent_filter_inside(MonteCarloSummary& m, const std::vector<std::vector<double>>& per_run,
                               std::vector<MonteCarloPhase>& phases,
@@ -109,7 +109,7 @@ Spread spread_of(const std::vector<double>& values) {
 
 double mean_nees_halfwidth95(const Spread& run_means) {
   if (run_means.n < 2) return kNaN;
-  return 1.959963984540054 * run_means.std / std::sqrt(static_cast<double>(run_means.n));
+  return kZ975 * run_means.std / std::sqrt(static_cast<double>(run_means.n));
 }
 
 MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs::path>& run_dirs) {

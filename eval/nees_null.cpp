@@ -59,7 +59,6 @@ ConsistentFilterInside simulate_consistent_inside(const Autoregression& ar, std:
                                                   const std::vector<std::vector<std::size_t>>& ranges,
                                                   std::size_t ranges_in_all, double target, int sims,
                                                   std::uint64_t seed) {
-  constexpr double kZ975 = 1.959963984540054;  // Phi^-1(0.975): the 95 % bounds in z
   ConsistentFilterInside out;
   out.median.assign(ranges.size(), 0.0);
   out.p_below.assign(ranges.size(), 0.0);

@@ -14,6 +14,9 @@
 
 namespace wingman::eval {
 
+// Phi^-1(0.975): the two-sided 95 % bounds of a standard normal.
+inline constexpr double kZ975 = 1.959963984540054;
+
 // Normalised autocorrelation r(0) = 1 .. r(max_lag) of the runs' series about their per-step
 // mean, over the steps [first, last). Every run must be finite there. Biased estimator (sums over
 // the overlap divided by the whole length), so the sequence is positive semi-definite.
