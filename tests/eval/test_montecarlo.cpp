@@ -15,23 +15,26 @@ using namespace wingman::eval;
 namespace fs = std::filesystem;
 
 namespace {
-// A run of 5 steps (t = 0..0.4 s) in two phases [0, 0.2) and [0.2, 0.4], with the given NEES
-// per step (step 0 has none) and lead x MSE per phase.
+// A run of nees.size() + 1 steps 0.1 s apart in two phases that split it in half (4 NEES: t =
+// 0..0.4 s, phases [0, 0.2) and [0.2, 0.4]), with the given NEES per step (step 0 has none) and
+// lead x MSE per phase.
 void write_run(const fs::path& dir, const std::vector<double>& nees, double mse_phase0, double mse_phase1) {
   fs::create_directories(dir);
+  const int steps = static_cast<int>(nees.size()) + 1;
+  const double end = 0.1 * (steps - 1), mid = 0.1 * ((steps - 1) / 2);
   nlohmann::json m;
   m["nees"]["dof"] = 6;
   m["nees"]["per_step"] = nlohmann::json::array({nullptr});
   for (double v : nees) m["nees"]["per_step"].push_back(v);
-  m["phases"] = {{{"name", "a"}, {"t_start", 0.0}, {"t_end", 0.2}},
-                 {{"name", "b"}, {"t_start", 0.2}, {"t_end", 0.4}}};
+  m["phases"] = {{{"name", "a"}, {"t_start", 0.0}, {"t_end", mid}},
+                 {{"name", "b"}, {"t_start", mid}, {"t_end", end}}};
   auto agents = [](double x) { return nlohmann::json{{"lead", {{"mse", {x, 0.0, 0.0}}}}}; };
   m["table4"]["phases"] = {{{"agents", agents(mse_phase0)}}, {{"agents", agents(mse_phase1)}}};
   m["table4"]["total"] = agents(0.5 * (mse_phase0 + mse_phase1));
   std::ofstream(dir / "metrics.json") << m.dump();
   std::ofstream csv(dir / "steps.csv");
   csv << "k,t,nees\n";
-  for (int k = 0; k < 5; ++k) csv << k << "," << 0.1 * k << ",0\n";
+  for (int k = 0; k < steps; ++k) csv << k << "," << 0.1 * k << ",0\n";
 }
 
 struct TempDir {
@@ -131,22 +134,10 @@ TEST(MonteCarlo, PhaseMeanIntervalAndConsistentFilterReferenceFromRuns) {
   std::chi_squared_distribution<double> chi2(6);
   std::vector<fs::path> dirs;
   for (int r = 0; r < 40; ++r) {
-    const fs::path dir = tmp.path / std::to_string(r);
-    fs::create_directories(dir);
-    nlohmann::json m;
-    m["nees"]["dof"] = 6;
-    m["nees"]["per_step"] = nlohmann::json::array({nullptr});
-    for (int k = 1; k <= 200; ++k) m["nees"]["per_step"].push_back(chi2(rng));
-    m["phases"] = {{{"name", "a"}, {"t_start", 0.0}, {"t_end", 10.0}},
-                   {{"name", "b"}, {"t_start", 10.0}, {"t_end", 20.0}}};
-    const auto agents = nlohmann::json{{"lead", {{"mse", {0.1, 0.0, 0.0}}}}};
-    m["table4"]["phases"] = {{{"agents", agents}}, {{"agents", agents}}};
-    m["table4"]["total"] = agents;
-    std::ofstream(dir / "metrics.json") << m.dump();
-    std::ofstream csv(dir / "steps.csv");
-    csv << "k,t\n";
-    for (int k = 0; k <= 200; ++k) csv << k << "," << 0.1 * k << "\n";
-    dirs.push_back(dir);
+    std::vector<double> nees(200);
+    for (double& v : nees) v = chi2(rng);
+    dirs.push_back(tmp.path / std::to_string(r));
+    write_run(dirs.back(), nees, 0.1, 0.1);
   }
   const MonteCarloSummary m = aggregate_runs("multi", dirs);
   ASSERT_EQ(m.phases.size(), 3u);
