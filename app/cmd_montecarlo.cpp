@@ -49,6 +49,7 @@ struct MonteCarloOptions {
   std::uint64_t first_seed = 1;
   std::vector<std::string> variants;
   bool resume = false;
+  int batch = 0;
   bool no_plots = false;
   bool quiet = false;
 };
@@ -106,6 +107,8 @@ std::vector<std::pair<std::string, std::string>> variant_labels(const std::vecto
 
 int montecarlo_command(const MonteCarloOptions& o) {
   if (o.runs < 1) throw UsageError("--runs must be at least 1");
+  if (o.batch != 0 && (o.batch < 2 || o.batch > o.runs))
+    throw UsageError(fmt::format("--batch {}: a batch needs 2 to --runs ({}) runs", o.batch, o.runs));
   // Bad input fails here, before any work.
   const auto scenarios = select_variants(sim::load_scenarios(o.scenario), o.variants, o.scenario);
   if (!o.no_plots && !eval::gnuplot_available())
@@ -214,6 +217,12 @@ int montecarlo_command(const MonteCarloOptions& o) {
     std::vector<fs::path> dirs;
     for (auto seed : finished) dirs.push_back(sub.empty() ? run_dir(out, seed) : run_dir(out, seed) / sub);
     summaries.push_back(eval::aggregate_runs(label, dirs));
+    if (o.batch > 0 && dirs.size() >= static_cast<std::size_t>(o.batch)) {
+      eval::BatchTest bt = eval::test_batches(label, dirs, static_cast<std::size_t>(o.batch));
+      for (auto& b : bt.batches)
+        b.label = fmt::format("seeds {}-{}", finished[b.first], finished[b.first + b.size - 1]);
+      summaries.back().batches = std::move(bt);
+    }
   }
   eval::write_monte_carlo(summaries, out);
   if (!o.no_plots) {
@@ -244,6 +253,9 @@ Subcommand add_montecarlo(CLI::App& parent) {
   cmd->add_option("--out,-o", o->out, "Output directory (default: results/<scenario name>_montecarlo)");
   cmd->add_option("--first-seed", o->first_seed, "Seed of the first run (default 1)");
   cmd->add_option("--variant", o->variants, "Run only these variants (repeatable)");
+  cmd->add_option("--batch", o->batch,
+                  "Also split the runs (by seed) into batches of this many and apply the per-step "
+                  "bounds test to each, with how often an exactly consistent filter passes it");
   cmd->add_flag("--resume", o->resume, "Keep the runs already finished in --out and run the rest");
   cmd->add_flag("--no-plots", o->no_plots, "Skip the NEES plot (no gnuplot needed)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");

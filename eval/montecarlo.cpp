@@ -248,6 +248,55 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
   return m;
 }
 
+double poisson_binomial_cdf(const std::vector<double>& p, int k) {
+  if (k < 0) return 0.0;
+  // dist[j]: probability of j successes among the trials so far.
+  std::vector<double> dist = {1.0};
+  for (double q : p) {
+    dist.push_back(0.0);
+    for (std::size_t j = dist.size() - 1; j > 0; --j) dist[j] = dist[j] * (1 - q) + dist[j - 1] * q;
+    dist[0] *= 1 - q;
+  }
+  double sum = 0;
+  for (std::size_t j = 0; j < dist.size() && static_cast<int>(j) <= k; ++j) sum += dist[j];
+  return std::min(1.0, sum);
+}
+
+BatchTest test_batches(const std::string& label, const std::vector<fs::path>& run_dirs,
+                       std::size_t batch_size) {
+  if (batch_size < 2 || run_dirs.size() < batch_size)
+    throw std::invalid_argument(fmt::format("{}: batches of {} runs need at least {} runs and 2 per "
+                                            "batch; {} finished", label, batch_size,
+                                            std::max<std::size_t>(batch_size, 2), run_dirs.size()));
+  BatchTest bt;
+  bt.batch_size = batch_size;
+  std::vector<double> p_pass;
+  for (std::size_t first = 0; first + batch_size <= run_dirs.size(); first += batch_size) {
+    const std::vector<fs::path> dirs(run_dirs.begin() + static_cast<std::ptrdiff_t>(first),
+                                     run_dirs.begin() + static_cast<std::ptrdiff_t>(first + batch_size));
+    const MonteCarloSummary m = aggregate_runs(label, dirs);
+    Batch b;
+    b.first = first;
+    b.size = batch_size;
+    b.label = fmt::format("runs {}-{}", first + 1, first + batch_size);
+    b.passed = true;
+    for (std::size_t i = 0; i + 1 < m.phases.size(); ++i) {  // the last is "total"
+      b.fraction_inside.push_back(m.phases[i].fraction_inside);
+      b.passed = b.passed && m.phases[i].fraction_inside >= kInsideTarget;
+    }
+    b.consistent_p_pass = m.consistent_p_all_phases_at_target;
+    bt.passed += b.passed;
+    p_pass.push_back(b.consistent_p_pass);
+    bt.batches.push_back(std::move(b));
+  }
+  if (std::all_of(p_pass.begin(), p_pass.end(), [](double q) { return std::isfinite(q); })) {
+    bt.consistent_expected_passes = 0;
+    for (double q : p_pass) bt.consistent_expected_passes += q;
+    bt.consistent_p_at_most_passed = poisson_binomial_cdf(p_pass, bt.passed);
+  }
+  return bt;
+}
+
 void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs::path& dir) {
   json out = json::array();
   for (const auto& m : summaries) {
@@ -277,6 +326,22 @@ void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs
       for (const auto& b : p.blocks)
         jp["nees_blocks"][b.agent] = {{"position", spread(b.position)}, {"velocity", spread(b.velocity)}};
       j["phases"].push_back(jp);
+    }
+    if (m.batches) {
+      const BatchTest& bt = *m.batches;
+      json jb{{"batch_size", bt.batch_size},
+              {"passed", bt.passed},
+              {"consistent_filter_expected_passes", bt.consistent_expected_passes},
+              {"consistent_filter_p_at_most_passed", bt.consistent_p_at_most_passed},
+              {"batches", json::array()}};
+      for (const auto& b : bt.batches)
+        jb["batches"].push_back({{"label", b.label},
+                                 {"first_run", b.first},
+                                 {"runs", b.size},
+                                 {"fraction_inside", b.fraction_inside},
+                                 {"passed", b.passed},
+                                 {"consistent_filter_p_pass", b.consistent_p_pass}});
+      j["batch_test"] = jb;
     }
     out.push_back(j);
   }
@@ -329,6 +394,20 @@ std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries) 
     }
     s += fmt::format("a consistent filter puts every phase at >= {:.0f}% inside with probability {:.0f}%\n",
                      100 * kInsideTarget, 100 * m.consistent_p_all_phases_at_target);
+    if (m.batches) {
+      const BatchTest& bt = *m.batches;
+      s += fmt::format("batches of {} runs, each against its own bounds:\n{:<12}", bt.batch_size, "batch");
+      for (std::size_t i = 0; i + 1 < m.phases.size(); ++i) s += fmt::format(" {:>9}", m.phases[i].name);
+      s += fmt::format(" {:>6} {:>26}\n", "pass", "consistent filter passes");
+      for (const auto& b : bt.batches) {
+        s += fmt::format("{:<12}", b.label);
+        for (double f : b.fraction_inside) s += fmt::format(" {:>8.1f}%", 100 * f);
+        s += fmt::format(" {:>6} {:>25.0f}%\n", b.passed ? "yes" : "no", 100 * b.consistent_p_pass);
+      }
+      s += fmt::format("{} of {} batches pass; a consistent filter passes {:.1f} on average, and {} or "
+                       "fewer with probability {:.0f}%\n", bt.passed, bt.batches.size(),
+                       bt.consistent_expected_passes, bt.passed, 100 * bt.consistent_p_at_most_passed);
+    }
     if (m.phases.front().blocks.empty()) continue;
     s += fmt::format("{:<10}", "NEES/block");
     for (const auto& b : m.phases.front().blocks)
@@ -337,11 +416,14 @@ std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries) 
     for (const auto& p : m.phases) {
       if (p.blocks.empty()) continue;
       s += fmt::format("{:<10}", p.name);
-      for (const auto& b : p.blocks) s += fmt::format(" {:>11.2f} {:>11.2f}", b.position.mean, b.velocity.mean);
+      for (const auto& b : p.blocks)
+        for (const Spread* q : {&b.position, &b.velocity})
+          s += fmt::format(" {:>11}", fmt::format("{:.2f}±{:.2f}", q->mean, mean_nees_halfwidth95(*q)));
       s += "\n";
     }
   }
-  s += "(MSE in m^2: mean ± std over the runs; NEES/block: 3 dof each, 3 when consistent)\n";
+  s += "(MSE in m^2: mean ± std over the runs; NEES/block: 3 dof each, 3 when consistent, ± the 95% "
+       "half-width over the runs)\n";
   return s;
 }
 

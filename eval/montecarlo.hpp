@@ -8,6 +8,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,26 @@ inline constexpr double kInsideTarget = 0.9;
 // 95 % half-width of the interval for the phase mean NEES from the runs' phase means.
 double mean_nees_halfwidth95(const Spread& run_means);
 
+// The per-step test applied to independent batches: runs [first, first + size) of the sorted
+// runs, each batch with its own bounds for `size` runs. It passes when every phase has at least
+// kInsideTarget of its steps inside them.
+struct Batch {
+  std::size_t first = 0, size = 0;
+  std::string label;  // "runs 1-50" unless the caller names them (by seed)
+  std::vector<double> fraction_inside;  // per phase, "total" left out
+  bool passed = false;
+  double consistent_p_pass = kNaN;  // an exactly consistent filter with this batch's correlation
+};
+struct BatchTest {
+  std::size_t batch_size = 0;
+  std::vector<Batch> batches;
+  int passed = 0;
+  // A consistent filter: the expected number of passing batches, and the probability of at most
+  // `passed` of them (each batch independent, with its own pass probability).
+  double consistent_expected_passes = kNaN;
+  double consistent_p_at_most_passed = kNaN;
+};
+
 struct MonteCarloSummary {
   std::string label;  // the variant, or the scenario name
   int runs = 0;
@@ -71,7 +92,16 @@ struct MonteCarloSummary {
   // Probability that an exactly consistent filter puts every phase (not "total") at or above
   // kInsideTarget, with these runs' error correlation.
   double consistent_p_all_phases_at_target = kNaN;
+  std::optional<BatchTest> batches;  // when asked for (`wingman montecarlo --batch`)
 };
+
+// P(X <= k) for X the number of successes of independent trials with these probabilities.
+double poisson_binomial_cdf(const std::vector<double>& p, int k);
+
+// Splits run_dirs (in the given order) into consecutive batches of batch_size, the remainder
+// left out, and tests each. Throws std::invalid_argument when fewer than one batch fits.
+BatchTest test_batches(const std::string& label, const std::vector<std::filesystem::path>& run_dirs,
+                       std::size_t batch_size);
 
 // Aggregates the results directories of N runs of one variant (each holding metrics.json and
 // steps.csv). Throws std::runtime_error naming the file when one is missing or malformed, or

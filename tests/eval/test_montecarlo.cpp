@@ -160,3 +160,61 @@ TEST(MonteCarlo, PhaseMeanIntervalAndConsistentFilterReferenceFromRuns) {
   EXPECT_TRUE(j[0]["phases"][0].contains("nees_mean_ci95"));
   EXPECT_TRUE(j[0]["phases"][0]["consistent_filter"]["median_fraction_inside"].is_number());
 }
+
+TEST(MonteCarlo, PoissonBinomialCdf) {
+  // Equal probabilities: the binomial. Four fair trials, at most one success: 5 / 16.
+  EXPECT_NEAR(poisson_binomial_cdf({0.5, 0.5, 0.5, 0.5}, 1), 5.0 / 16.0, 1e-12);
+  // {0.2, 0.7}: P(0) = 0.8 * 0.3, P(1) = 0.2 * 0.3 + 0.8 * 0.7.
+  EXPECT_NEAR(poisson_binomial_cdf({0.2, 0.7}, 0), 0.24, 1e-12);
+  EXPECT_NEAR(poisson_binomial_cdf({0.2, 0.7}, 1), 0.86, 1e-12);
+  EXPECT_NEAR(poisson_binomial_cdf({0.2, 0.7}, 2), 1.0, 1e-12);
+  EXPECT_EQ(poisson_binomial_cdf({0.2, 0.7}, -1), 0.0);
+}
+
+TEST(MonteCarlo, BatchesEachAgainstTheirOwnBounds) {
+  TempDir tmp;
+  // Six runs of 201 steps, NEES ~ chi2(6) white in time, in three batches of two. The second
+  // batch's runs are overconfident through phase b (NEES x 5), so it fails there; the seventh
+  // run is left out.
+  std::mt19937_64 rng(5);
+  std::chi_squared_distribution<double> chi2(6);
+  std::vector<fs::path> dirs;
+  for (int r = 0; r < 7; ++r) {
+    std::vector<double> nees(200);
+    for (int k = 0; k < 200; ++k) nees[k] = chi2(rng) * ((r == 2 || r == 3) && k >= 100 ? 5.0 : 1.0);
+    dirs.push_back(tmp.path / std::to_string(r));
+    write_run(dirs.back(), nees, 0.1, 0.1);
+  }
+  const BatchTest bt = test_batches("multi", dirs, 2);
+  ASSERT_EQ(bt.batches.size(), 3u);
+  EXPECT_EQ(bt.batch_size, 2u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const MonteCarloSummary m = aggregate_runs("multi", {dirs[2 * i], dirs[2 * i + 1]});
+    const Batch& b = bt.batches[i];
+    EXPECT_EQ(b.first, 2 * i);
+    ASSERT_EQ(b.fraction_inside.size(), 2u);  // phases a and b, not "total"
+    EXPECT_DOUBLE_EQ(b.fraction_inside[0], m.phases[0].fraction_inside);
+    EXPECT_DOUBLE_EQ(b.fraction_inside[1], m.phases[1].fraction_inside);
+    EXPECT_DOUBLE_EQ(b.consistent_p_pass, m.consistent_p_all_phases_at_target);
+  }
+  EXPECT_EQ(bt.batches[1].label, "runs 3-4");
+  EXPECT_LT(bt.batches[1].fraction_inside[1], 0.2);  // mean 30 against bounds for 2 runs of 6 dof, [2.2, 11.7]
+  EXPECT_FALSE(bt.batches[1].passed);
+  int passed = 0;
+  std::vector<double> p;
+  for (const auto& b : bt.batches) passed += b.passed, p.push_back(b.consistent_p_pass);
+  EXPECT_EQ(bt.passed, passed);
+  EXPECT_NEAR(bt.consistent_expected_passes, p[0] + p[1] + p[2], 1e-12);
+  EXPECT_NEAR(bt.consistent_p_at_most_passed, poisson_binomial_cdf(p, passed), 1e-12);
+
+  MonteCarloSummary m = aggregate_runs("multi", dirs);
+  m.batches = bt;
+  const std::string table = format_monte_carlo({m});
+  EXPECT_NE(table.find("batches of 2 runs"), std::string::npos) << table;
+  write_monte_carlo({m}, tmp.path);
+  const auto j = nlohmann::json::parse(std::ifstream(tmp.path / "montecarlo.json"));
+  EXPECT_EQ(j[0]["batch_test"]["batches"].size(), 3u);
+  EXPECT_EQ(j[0]["batch_test"]["passed"].get<int>(), passed);
+
+  EXPECT_THROW(test_batches("multi", {dirs[0]}, 2), std::invalid_argument);
+}
