@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -35,6 +36,22 @@ void write_run(const fs::path& dir, const std::vector<double>& nees, double mse_
   std::ofstream csv(dir / "steps.csv");
   csv << "k,t,nees\n";
   for (int k = 0; k < steps; ++k) csv << k << "," << 0.1 * k << ",0\n";
+}
+
+// `runs` runs of 201 steps (phases [0, 10) and [10, 20] s) under root/<r>, NEES ~ chi2(6) white
+// in time, times scale(run, step).
+std::vector<fs::path> write_chi2_runs(const fs::path& root, int runs, std::uint64_t seed,
+                                      const std::function<double(int, int)>& scale) {
+  std::mt19937_64 rng(seed);
+  std::chi_squared_distribution<double> chi2(6);
+  std::vector<fs::path> dirs;
+  for (int r = 0; r < runs; ++r) {
+    std::vector<double> nees(200);
+    for (int k = 0; k < 200; ++k) nees[k] = chi2(rng) * scale(r, k);
+    dirs.push_back(root / std::to_string(r));
+    write_run(dirs.back(), nees, 0.1, 0.1);
+  }
+  return dirs;
 }
 
 struct TempDir {
@@ -130,15 +147,7 @@ TEST(MonteCarlo, PhaseMeanIntervalAndConsistentFilterReferenceFromRuns) {
   TempDir tmp;
   // 40 runs of 201 steps at 10 Hz, phases [0, 10) and [10, 20]; NEES ~ chi2(6), white in time:
   // the interval holds 6 and a consistent filter keeps a phase of 100 steps inside 95 % of them.
-  std::mt19937_64 rng(11);
-  std::chi_squared_distribution<double> chi2(6);
-  std::vector<fs::path> dirs;
-  for (int r = 0; r < 40; ++r) {
-    std::vector<double> nees(200);
-    for (double& v : nees) v = chi2(rng);
-    dirs.push_back(tmp.path / std::to_string(r));
-    write_run(dirs.back(), nees, 0.1, 0.1);
-  }
+  const auto dirs = write_chi2_runs(tmp.path, 40, 11, [](int, int) { return 1.0; });
   const MonteCarloSummary m = aggregate_runs("multi", dirs);
   ASSERT_EQ(m.phases.size(), 3u);
   for (const auto& p : m.phases) {
@@ -176,15 +185,9 @@ TEST(MonteCarlo, BatchesEachAgainstTheirOwnBounds) {
   // Six runs of 201 steps, NEES ~ chi2(6) white in time, in three batches of two. The second
   // batch's runs are overconfident through phase b (NEES x 5), so it fails there; the seventh
   // run is left out.
-  std::mt19937_64 rng(5);
-  std::chi_squared_distribution<double> chi2(6);
-  std::vector<fs::path> dirs;
-  for (int r = 0; r < 7; ++r) {
-    std::vector<double> nees(200);
-    for (int k = 0; k < 200; ++k) nees[k] = chi2(rng) * ((r == 2 || r == 3) && k >= 100 ? 5.0 : 1.0);
-    dirs.push_back(tmp.path / std::to_string(r));
-    write_run(dirs.back(), nees, 0.1, 0.1);
-  }
+  const auto dirs = write_chi2_runs(tmp.path, 7, 5, [](int r, int k) {
+    return (r == 2 || r == 3) && k >= 100 ? 5.0 : 1.0;
+  });
   const BatchTest bt = test_batches("multi", dirs, 2);
   ASSERT_EQ(bt.batches.size(), 3u);
   EXPECT_EQ(bt.batch_size, 2u);
