@@ -52,12 +52,17 @@ TEST(MonteCarloCli, RunsInWorkersAggregatesAndResumes) {
 
   // With --resume, once the blocker is gone, only seed 2 runs and all three are aggregated.
   fs::remove_all(out / "runs" / "seed2");
+  // --batch 2 tests seeds 1-2 as one batch; seed 3 is left out of it.
   r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "3", "--out", out.string(), "--no-plots",
-                   "--variant", "multi", "--resume"},
+                   "--variant", "multi", "--resume", "--batch", "2"},
                   tmp.path());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("2 of 3 runs already finished")) << r.output;
-  EXPECT_EQ(nlohmann::json::parse(read_file(out / "montecarlo.json"))[0]["runs"], 3);
+  EXPECT_THAT(r.output, HasSubstr("batches of 2 runs")) << r.output;
+  const auto resumed = nlohmann::json::parse(read_file(out / "montecarlo.json"));
+  EXPECT_EQ(resumed[0]["runs"], 3);
+  ASSERT_EQ(resumed[0]["batch_test"]["batches"].size(), 1u);
+  EXPECT_EQ(resumed[0]["batch_test"]["batches"][0]["label"], "seeds 1-2");
 }
 
 TEST(MonteCarloCli, BadInputExits2AndWritesNothing) {
@@ -71,6 +76,12 @@ TEST(MonteCarloCli, BadInputExits2AndWritesNothing) {
   r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "0", "--out", out.string(), "--no-plots"},
                   tmp.path());
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "2", "--batch", "3", "--out", out.string(),
+                   "--no-plots"},
+                  tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--batch 3")) << r.output;
   EXPECT_FALSE(fs::exists(out));
   // A directory that is not ours is refused.
   fs::create_directories(out);
