@@ -222,6 +222,9 @@ int montecarlo_command(const MonteCarloOptions& o) {
       for (auto& b : bt.batches)
         b.label = fmt::format("seeds {}-{}", finished[b.first], finished[b.first + b.size - 1]);
       summaries.back().batches = std::move(bt);
+    } else if (o.batch > 0) {
+      fmt::print(stderr, "{}: {} runs finished, fewer than one batch of {}: no batch test\n", label,
+                 dirs.size(), o.batch);
     }
   }
   eval::write_monte_carlo(summaries, out);

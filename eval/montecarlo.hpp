@@ -4,7 +4,8 @@
 // and the mean and spread of the Table 4 metrics per phase. Reads what `wingman run` wrote.
 // Because the fraction inside is itself random (eval/nees_null.hpp), each phase also gets the
 // runs' mean NEES with a confidence interval and what an exactly consistent filter with the same
-// error correlation would show.
+// error correlation would show, and, on request, the per-step test on independent batches of
+// the runs beside how many of them a consistent filter would pass.
 #pragma once
 
 #include <filesystem>
