@@ -1,7 +1,8 @@
 // `wingman montecarlo`: N seeds of a scenario in parallel worker processes (each a `wingman run`
 // writing its own results directory under <out>/runs/), then the aggregate of DESIGN.md §7:
 // average NEES with its chi^2 bounds per step, the fraction of steps inside them per phase, and
-// the spread of Table 4 (eval/montecarlo). Workers are processes, not threads, so a crash or an
+// the spread of Table 4 (eval/montecarlo), and every later variant compared with the first seed by
+// seed (eval/paired: the paper scenes' single-UAV against multi-UAV). Workers are processes, not threads, so a crash or an
 // abort in one run costs that run only. Ctrl-C stops the workers and keeps the finished runs;
 // --resume skips them.
 #include <CLI/CLI.hpp>
@@ -28,6 +29,7 @@
 #include "app/subcommand.hpp"
 #include "app/variants.hpp"
 #include "eval/montecarlo.hpp"
+#include "eval/paired.hpp"
 #include "eval/plots.hpp"
 #include "eval/results_dir.hpp"
 #include "sim/scenario.hpp"
@@ -213,9 +215,11 @@ int montecarlo_command(const MonteCarloOptions& o) {
     return 1;
   }
   std::vector<eval::MonteCarloSummary> summaries;
+  std::vector<std::pair<std::string, std::vector<fs::path>>> variant_dirs;
   for (const auto& [label, sub] : variant_labels(scenarios)) {
     std::vector<fs::path> dirs;
     for (auto seed : finished) dirs.push_back(sub.empty() ? run_dir(out, seed) : run_dir(out, seed) / sub);
+    variant_dirs.emplace_back(label, dirs);
     summaries.push_back(eval::aggregate_runs(label, dirs));
     if (o.batch > 0 && dirs.size() >= static_cast<std::size_t>(o.batch)) {
       eval::BatchTest bt = eval::test_batches(label, dirs, static_cast<std::size_t>(o.batch));
@@ -228,6 +232,12 @@ int montecarlo_command(const MonteCarloOptions& o) {
     }
   }
   eval::write_monte_carlo(summaries, out);
+  // Every later variant against the first, seed by seed (the paper scenes: single against multi).
+  std::vector<eval::PairedComparison> comparisons;
+  for (std::size_t v = 1; v < variant_dirs.size(); ++v)
+    comparisons.push_back(eval::compare_paired(variant_dirs[0].first, variant_dirs[0].second,
+                                               variant_dirs[v].first, variant_dirs[v].second));
+  if (!comparisons.empty()) eval::write_paired(comparisons, out / "comparison.json");
   if (!o.no_plots) {
     fs::create_directories(out / "plots");
     eval::plot_monte_carlo_nees(summaries, out);
@@ -236,6 +246,7 @@ int montecarlo_command(const MonteCarloOptions& o) {
     fmt::print("Monte Carlo of {}: {} runs finished (seeds {}..{}), {} failed\n", o.scenario,
                finished.size(), o.first_seed, o.first_seed + o.runs - 1, failed.size());
     fmt::print("{}", eval::format_monte_carlo(summaries));
+    for (const auto& c : comparisons) fmt::print("{}", eval::format_paired(c));
     fmt::print("results: {}\n", out.string());
   }
   for (const auto& [seed, why] : failed) fmt::print(stderr, "failed: seed {}: {}\n", seed, why);

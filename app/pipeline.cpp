@@ -395,6 +395,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
         auto key = std::minmax(j, o);
         pairs[key] = std::max(pairs[key], need);
       }
+      std::vector<int> added(ncam, 0);  // this step's cooperative landmarks, per camera
       for (const auto& [pr, need] : pairs) {
         if (fe) {
           const auto tm0 = Clock::now();
@@ -411,6 +412,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
             if (pairs_found[i].outlier) ++coop->outliers_accepted;
             add_rendered(*outcomes[i].id, pr.first, pairs_found[i].keypoint_a, pairs_found[i].m.uv_a,
                          "cooperative");
+            ++added[pr.first], ++added[pr.second];
           }
           continue;
         }
@@ -425,7 +427,23 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
           ++coop->accepted;
           if (matches[i].injected_outlier) ++coop->outliers_accepted;
           add_record(*outcomes[i].id, matches[i].point, "cooperative");
+          ++added[pr.first], ++added[pr.second];
         }
+      }
+      // The cameras cooperative matching left short fill up on their own, in inverse depth.
+      for (int j = 0; j < ncam && scn.estimator.monocular_fill; ++j) {
+        const int need = target - in_view[j] - added[j];
+        if (!sees_landmarks[j] || need <= 0) continue;
+        if (fe) {
+          const auto tm0 = Clock::now();
+          const auto pts = fe->new_points(j, need);
+          t_cross += ms_since(tm0);
+          for (const auto& p : pts)
+            if (auto r = est.initialise_from_pixel(j, p.c.uv); r.id)
+              add_rendered(*r.id, j, p.keypoint, p.c.uv, "inverse_depth");
+        } else
+          for (const auto& o : source.new_points(cam_uav[j], t, need))
+            if (auto r = est.initialise_from_pixel(j, o.uv); r.id) add_record(*r.id, o.point, "inverse_depth");
       }
     }
     for (slam::LandmarkId id : est.end_step()) {

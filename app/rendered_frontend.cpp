@@ -326,6 +326,9 @@ std::vector<LabelledPair> RenderedFrontend::cross_match(int cam_a, int cam_b, in
     LabelledPair lp;
     lp.m = {cam_a, cam_b, m.uv_a, m.uv_b};
     lp.keypoint_a = m.keypoint_a;
+    // Taken: a camera that then fills its own deficit (new_points) must not pick them again.
+    a.used[m.keypoint_a] = true;
+    b.used[m.keypoint_b] = true;
     a.fresh.push_back(m.uv_a);
     b.fresh.push_back(m.uv_b);
     lp.outlier = vision::label_pixel_pair(m.uv_a, a.model, a.true_pose, a.frame.depth, m.uv_b,
@@ -350,7 +353,8 @@ std::vector<LabelledCorrespondence> RenderedFrontend::new_points(int cam, int ne
     m.uv_a = m.uv_b = c.features.pixel(i);
     cand.push_back(m);
   }
-  std::vector<Eigen::Vector2d> existing;
+  // Spread away from the landmarks in view and from this step's cooperative ones.
+  std::vector<Eigen::Vector2d> existing = c.fresh;
   for (const auto& p : c.preds) existing.push_back(p.uv);
   std::vector<LabelledCorrespondence> out;
   for (const auto& m : vision::select_spread(cand, needed, c.model, existing, c.model, existing)) {

@@ -165,6 +165,10 @@ struct EstimatorSpec {
   // A pair under min_parallax_deg becomes an inverse-depth landmark anchored at the first camera
   // and corrected with the second pixel, instead of being rejected.
   bool low_parallax_inverse_depth = false;
+  // Multi-UAV: a camera that cooperative matching leaves under target_per_camera initialises the
+  // rest from its own pixels in inverse depth, as the single-UAV baseline does. Not the paper's
+  // method (section 5.2 initialises cooperatively only), so off by default.
+  bool monocular_fill = false;
   // Single-UAV inverse-depth initialisation (Montiel et al. 2006, Civera et al. 2008).
   double inverse_depth_rho = 0.05;    // 1/m
   double inverse_depth_sigma = 0.04;  // 1/m

@@ -43,6 +43,7 @@ TEST(MonteCarloCli, RunsInWorkersAggregatesAndResumes) {
   EXPECT_GT(total["nees_steps"].get<int>(), 100);
   EXPECT_GE(total["nees_fraction_inside"].get<double>(), 0.0);
   EXPECT_TRUE(fs::exists(out / "nees.csv"));
+  EXPECT_FALSE(fs::exists(out / "comparison.json"));  // one variant: nothing to compare
 
   // Without --resume the finished runs are not mixed in silently.
   r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "3", "--out", out.string(), "--no-plots"},
@@ -63,6 +64,28 @@ TEST(MonteCarloCli, RunsInWorkersAggregatesAndResumes) {
   EXPECT_EQ(resumed[0]["runs"], 3);
   ASSERT_EQ(resumed[0]["batch_test"]["batches"].size(), 1u);
   EXPECT_EQ(resumed[0]["batch_test"]["batches"][0]["label"], "seeds 1-2");
+}
+
+// With both variants, single-UAV is compared with multi-UAV seed by seed (eval/paired.hpp).
+TEST(MonteCarloCli, ComparesTheVariantsSeedBySeed) {
+  TempDir tmp;
+  const fs::path out = tmp / "mc";
+  const RunResult r = run_wingman(
+      {"montecarlo", kSmoke.string(), "--runs", "2", "--jobs", "2", "--out", out.string(), "--no-plots"},
+      tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("single against multi, paired over 2 seeds")) << r.output;
+  const auto c = nlohmann::json::parse(read_file(out / "comparison.json"));
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_EQ(c[0]["a"], "multi");
+  EXPECT_EQ(c[0]["b"], "single");
+  ASSERT_EQ(c[0]["rows"].size(), 9u);  // lead, uav1 and the landmarks, x y z each
+  EXPECT_EQ(c[0]["rows"][0]["agent"], "lead");
+  EXPECT_EQ(c[0]["rows"][8]["agent"], "landmarks");
+  for (const auto& row : c[0]["rows"]) {
+    EXPECT_EQ(row["seeds"], 2);
+    EXPECT_GT(row["ratio_b_over_a"].get<double>(), 0.0);
+  }
 }
 
 TEST(MonteCarloCli, BadInputExits2AndWritesNothing) {

@@ -207,6 +207,28 @@ TEST(PipelineSmoke, MultiUavLeadErrorStaysBoundedAndNeesFinite) {
       rec.steps.back().nees_dof, nees_n ? nees_sum / nees_n : NAN, nees_max, rec.landmarks.size());
 }
 
+// estimator.initialisation.monocular_fill: with a target the cooperative matches cannot meet,
+// the multi-UAV cameras fill up with their own inverse-depth landmarks (none without the key),
+// and the estimate stays as bounded as the cooperative-only one.
+TEST(PipelineSmoke, MonocularFillAddsInverseDepthLandmarksInMultiUavMode) {
+  sim::Scenario scn = smoke_variant("multi");
+  scn.estimator.target_landmarks_per_camera = 40;
+  scn.estimator.low_parallax_inverse_depth = false;  // only pairs over 8 degrees: the middle
+  auto inverse_depth_count = [](const eval::RunRecord& r) {
+    return std::count_if(r.landmarks.begin(), r.landmarks.end(),
+                         [](const eval::LandmarkRecord& l) { return l.origin == "inverse_depth"; });
+  };
+  const auto without = run_synthetic(scn);
+  EXPECT_EQ(inverse_depth_count(without), 0);
+  scn.estimator.monocular_fill = true;
+  const auto with = run_synthetic(scn);
+  EXPECT_GT(inverse_depth_count(with), 20);
+  EXPECT_GT(with.landmarks.size(), without.landmarks.size());
+  for (const auto& st : with.steps)
+    for (std::size_t a = 0; a < st.agents.size(); ++a)
+      ASSERT_LT((st.agents[a].p_est - st.agents[a].p_true).norm(), 3.0) << with.agent_names[a] << " k=" << st.k;
+}
+
 TEST(PipelineSmoke, SameSeedGivesIdenticalEstimates) {
   for (const std::string variant : {"multi", "single"}) {
     const sim::Scenario scn = smoke_variant(variant);

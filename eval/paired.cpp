@@ -1,0 +1,187 @@
+#include "eval/paired.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace wingman::eval {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+json read_metrics(const fs::path& dir) {
+  const fs::path path = dir / "metrics.json";
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open", path.string()));
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw std::runtime_error(fmt::format("{}: not valid JSON: {}", path.string(), e.what()));
+  }
+}
+
+// The three numbers at j[keys...], or a runtime_error naming the file and the key.
+std::vector<double> triple(const json& j, const std::vector<std::string>& keys, const fs::path& dir) {
+  const json* p = &j;
+  std::string where;
+  for (const auto& k : keys) {
+    where += (where.empty() ? "" : ".") + k;
+    if (!p->is_object() || !p->contains(k))
+      throw std::runtime_error(fmt::format("{}: no '{}'", (dir / "metrics.json").string(), where));
+    p = &(*p)[k];
+  }
+  if (!p->is_array() || p->size() != 3)
+    throw std::runtime_error(fmt::format("{}: '{}' is not three numbers", (dir / "metrics.json").string(), where));
+  std::vector<double> v;
+  for (const auto& x : *p) v.push_back(x.is_number() ? x.get<double>() : kNaN);
+  return v;
+}
+
+// Student's t density with `dof` degrees of freedom.
+double t_density(double t, double dof) {
+  const double c = std::lgamma(0.5 * (dof + 1)) - std::lgamma(0.5 * dof) - 0.5 * std::log(dof * M_PI);
+  return std::exp(c - 0.5 * (dof + 1) * std::log1p(t * t / dof));
+}
+
+// P(T <= t) for t >= 0: 1/2 plus the density integrated by Simpson's rule (smooth, unimodal).
+double t_cdf_nonnegative(double t, double dof) {
+  constexpr int kIntervals = 2000;  // even
+  const double h = t / kIntervals;
+  double sum = t_density(0, dof) + t_density(t, dof);
+  for (int i = 1; i < kIntervals; ++i) sum += (i % 2 ? 4 : 2) * t_density(i * h, dof);
+  return 0.5 + sum * h / 3;
+}
+
+}  // namespace
+
+double sign_test_p(int k, int n) {
+  if (n <= 0) return kNaN;
+  const int m = std::min(k, n - k);
+  // log C(n, i) - n log 2, summed in linear space (n is at most a few thousand seeds).
+  double tail = 0;
+  for (int i = 0; i <= m; ++i)
+    tail += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) - n * std::log(2.0));
+  return std::min(1.0, 2 * tail);
+}
+
+double student_t_quantile(double p, double dof) {
+  if (!(p > 0 && p < 1) || !(dof >= 1))
+    throw std::invalid_argument(fmt::format("student_t_quantile: p = {} must be in (0, 1) and dof = {} >= 1", p, dof));
+  if (p < 0.5) return -student_t_quantile(1 - p, dof);
+  double lo = 0, hi = 1;
+  while (t_cdf_nonnegative(hi, dof) < p) hi *= 2;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (t_cdf_nonnegative(mid, dof) < p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+PairedRow compare_values(const std::vector<double>& a, const std::vector<double>& b) {
+  PairedRow r;
+  std::vector<double> logs;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    if (!(std::isfinite(a[i]) && std::isfinite(b[i]) && a[i] > 0 && b[i] > 0)) continue;
+    ++r.seeds;
+    if (b[i] > a[i]) ++r.b_worse;
+    logs.push_back(std::log(b[i] / a[i]));
+  }
+  r.sign_p = sign_test_p(r.b_worse, r.seeds);
+  if (logs.size() < 2) return r;
+  const double n = static_cast<double>(logs.size());
+  double mean = 0, var = 0;
+  for (double x : logs) mean += x / n;
+  for (double x : logs) var += (x - mean) * (x - mean) / (n - 1);
+  const double hw = student_t_quantile(0.975, n - 1) * std::sqrt(var / n);
+  r.ratio = std::exp(mean);
+  r.ratio_lo = std::exp(mean - hw);
+  r.ratio_hi = std::exp(mean + hw);
+  return r;
+}
+
+PairedComparison compare_paired(const std::string& a, const std::vector<fs::path>& dirs_a,
+                                const std::string& b, const std::vector<fs::path>& dirs_b) {
+  if (dirs_a.size() != dirs_b.size())
+    throw std::invalid_argument(fmt::format("compare_paired: {} runs of {} against {} of {}", dirs_a.size(),
+                                            a, dirs_b.size(), b));
+  PairedComparison c{a, b, static_cast<int>(dirs_a.size()), {}};
+  if (dirs_a.empty()) return c;
+  std::vector<json> ja, jb;
+  for (std::size_t i = 0; i < dirs_a.size(); ++i) {
+    ja.push_back(read_metrics(dirs_a[i]));
+    jb.push_back(read_metrics(dirs_b[i]));
+  }
+  // Table 4's agents of A (in its order) that B has too, read from the first seed.
+  std::vector<std::string> agents;
+  const auto& total = ja.front()["table4"]["total"];
+  if (!total.is_object())
+    throw std::runtime_error(fmt::format("{}: no 'table4.total'", (dirs_a.front() / "metrics.json").string()));
+  for (const auto& [agent, v] : total.items())
+    if (jb.front()["table4"]["total"].contains(agent)) agents.push_back(agent);
+  // nlohmann's object keys are sorted; put the lead first, as the tables do.
+  std::stable_partition(agents.begin(), agents.end(), [](const std::string& s) { return s == "lead"; });
+
+  auto add = [&](const std::string& quantity, const std::string& label, const std::vector<std::string>& keys) {
+    std::vector<std::vector<double>> va, vb;
+    for (std::size_t i = 0; i < ja.size(); ++i) {
+      va.push_back(triple(ja[i], keys, dirs_a[i]));
+      vb.push_back(triple(jb[i], keys, dirs_b[i]));
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<double> xa, xb;
+      for (std::size_t i = 0; i < va.size(); ++i) xa.push_back(va[i][axis]), xb.push_back(vb[i][axis]);
+      PairedRow r = compare_values(xa, xb);
+      r.quantity = quantity;
+      r.agent = label;
+      r.axis = axis;
+      c.rows.push_back(r);
+    }
+  };
+  for (const auto& agent : agents) add("table4", agent, {"table4", "total", agent, "mse"});
+  add("table5", "landmarks", {"table5", "total", "final_mse"});
+  return c;
+}
+
+std::string format_paired(const PairedComparison& c) {
+  std::string s = fmt::format(
+      "\n{} against {}, paired over {} seeds (MSE totals; ratio: geometric mean of {} / {} with its 95% "
+      "interval; p: two-sided sign test)\n",
+      c.b, c.a, c.seeds, c.b, c.a);
+  s += fmt::format("{:<8} {:<10} {:<4} {:>14} {:>7} {:>8} {:>18}\n", "table", "agent", "axis",
+                   c.b + " worse", "p", "ratio", "95% interval");
+  for (const auto& r : c.rows) {
+    const std::string interval =
+        std::isfinite(r.ratio_lo) ? fmt::format("[{:.2f}, {:.2f}]", r.ratio_lo, r.ratio_hi) : "-";
+    s += fmt::format("{:<8} {:<10} {:<4} {:>14} {:>7.3f} {:>8.2f} {:>18}\n",
+                     r.quantity == "table4" ? "4" : "5 final", r.agent, std::string(1, "xyz"[r.axis]),
+                     fmt::format("{} of {}", r.b_worse, r.seeds), r.sign_p, r.ratio, interval);
+  }
+  return s;
+}
+
+void write_paired(const std::vector<PairedComparison>& comparisons, const fs::path& path) {
+  json out = json::array();
+  for (const auto& c : comparisons) {
+    json j{{"a", c.a}, {"b", c.b}, {"seeds", c.seeds}, {"rows", json::array()}};
+    for (const auto& r : c.rows)
+      j["rows"].push_back({{"quantity", r.quantity},
+                           {"agent", r.agent},
+                           {"axis", std::string(1, "xyz"[r.axis])},
+                           {"seeds", r.seeds},
+                           {"b_worse", r.b_worse},
+                           {"sign_test_p", r.sign_p},
+                           {"ratio_b_over_a", r.ratio},
+                           {"ratio_ci95", {r.ratio_lo, r.ratio_hi}}});
+    out.push_back(j);
+  }
+  std::ofstream f(path);
+  f << out.dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+  if (!f) throw std::runtime_error(fmt::format("{}: write failed", path.string()));
+}
+
+}  // namespace wingman::eval
