@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "eval/json_file.hpp"
 #include "eval/nees_null.hpp"
 #include "geometry/chi2.hpp"
 
@@ -17,16 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-json read_json(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot open", path.string()));
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw std::runtime_error(fmt::format("{}: not valid JSON: {}", path.string(), e.what()));
-  }
-}
 
 // The 't' column of steps.csv.
 std::vector<double> read_times(const fs::path& path) {
@@ -118,7 +109,7 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
   m.label = label;
   m.runs = static_cast<int>(run_dirs.size());
   std::vector<json> metrics;
-  for (const auto& dir : run_dirs) metrics.push_back(read_json(dir / "metrics.json"));
+  for (const auto& dir : run_dirs) metrics.push_back(read_json_file(dir / "metrics.json"));
   m.t = read_times(run_dirs.front() / "steps.csv");
   const std::size_t steps = m.t.size();
 

@@ -8,22 +8,15 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "eval/json_file.hpp"
+
 namespace wingman::eval {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-json read_metrics(const fs::path& dir) {
-  const fs::path path = dir / "metrics.json";
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot open", path.string()));
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw std::runtime_error(fmt::format("{}: not valid JSON: {}", path.string(), e.what()));
-  }
-}
+json read_metrics(const fs::path& dir) { return read_json_file(dir / "metrics.json"); }
 
 // The three numbers at j[keys...], or a runtime_error naming the file and the key.
 std::vector<double> triple(const json& j, const std::vector<std::string>& keys, const fs::path& dir) {
