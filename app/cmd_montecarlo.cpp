@@ -2,9 +2,9 @@
 // writing its own results directory under <out>/runs/), then the aggregate of DESIGN.md §7:
 // average NEES with its chi^2 bounds per step, the fraction of steps inside them per phase, and
 // the spread of Table 4 (eval/montecarlo), and every later variant compared with the first seed by
-// seed (eval/paired: the paper scenes' single-UAV against multi-UAV). Workers are processes, not threads, so a crash or an
-// abort in one run costs that run only. Ctrl-C stops the workers and keeps the finished runs;
-// --resume skips them.
+// seed (eval/paired: the paper scenes' single-UAV against multi-UAV). Workers are processes, not
+// threads, so a crash or an abort in one run costs that run only. Ctrl-C stops the workers and
+// keeps the finished runs; --resume skips them.
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include <fcntl.h>
