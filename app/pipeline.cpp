@@ -51,6 +51,7 @@ slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
   s.visual.max_hypotheses = e.ransac_max_hypotheses;
   s.cooperative.min_parallax_deg = e.min_parallax_deg;
   s.cooperative.max_reprojection_px = e.max_reprojection_px;
+  s.cooperative.min_depth_m = e.min_depth_m;
   s.cooperative.low_parallax_inverse_depth = e.low_parallax_inverse_depth;
   s.inverse_depth.rho = e.inverse_depth_rho;
   s.inverse_depth.sigma_rho = e.inverse_depth_sigma;

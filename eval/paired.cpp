@@ -137,21 +137,59 @@ PairedComparison compare_paired(const std::string& a, const std::vector<fs::path
   };
   for (const auto& agent : agents) add("table4", agent, {"table4", "total", agent, "mse"});
   add("table5", "landmarks", {"table5", "total", "final_mse"});
+
+  // Per phase: the MSE triple of `agent` in the phase called `name`, or NaNs where it is missing.
+  auto phase_mse = [](const json& j, const std::string& name, const std::string& agent) {
+    std::vector<double> v(3, kNaN);
+    if (!j.contains("table4") || !j["table4"].contains("phases") || !j["table4"]["phases"].is_array())
+      return v;
+    for (const auto& ph : j["table4"]["phases"]) {
+      if (!ph.is_object() || !ph.contains("name") || ph["name"] != name) continue;
+      if (!ph.contains("agents") || !ph["agents"].contains(agent) || !ph["agents"][agent].is_object() ||
+          !ph["agents"][agent].contains("mse"))
+        return v;
+      const json& mse = ph["agents"][agent]["mse"];
+      if (mse.is_array() && mse.size() == 3)
+        for (int k = 0; k < 3; ++k) v[k] = mse[k].is_number() ? mse[k].get<double>() : kNaN;
+      return v;
+    }
+    return v;
+  };
+  std::vector<std::string> phase_names;
+  if (const json& t4 = ja.front()["table4"]; t4.contains("phases") && t4["phases"].is_array())
+    for (const auto& ph : t4["phases"])
+      if (ph.is_object() && ph.contains("name") && ph["name"].is_string()) phase_names.push_back(ph["name"]);
+  for (const auto& name : phase_names)
+    for (const auto& agent : agents)
+      for (int axis = 0; axis < 3; ++axis) {
+        std::vector<double> xa, xb;
+        for (std::size_t i = 0; i < ja.size(); ++i) {
+          xa.push_back(phase_mse(ja[i], name, agent)[axis]);
+          xb.push_back(phase_mse(jb[i], name, agent)[axis]);
+        }
+        PairedRow r = compare_values(xa, xb);
+        r.quantity = "table4";
+        r.agent = agent;
+        r.phase = name;
+        r.axis = axis;
+        c.rows.push_back(r);
+      }
   return c;
 }
 
 std::string format_paired(const PairedComparison& c) {
   std::string s = fmt::format(
-      "\n{} against {}, paired over {} seeds (MSE totals; ratio: geometric mean of {} / {} with its 95% "
-      "interval; p: two-sided sign test)\n",
+      "\n{} against {}, paired over {} seeds (MSE, totals then per phase; ratio: geometric mean of {} / {} "
+      "with its 95% interval; p: two-sided sign test)\n",
       c.b, c.a, c.seeds, c.b, c.a);
-  s += fmt::format("{:<8} {:<10} {:<4} {:>14} {:>7} {:>8} {:>18}\n", "table", "agent", "axis",
+  s += fmt::format("{:<16} {:<10} {:<4} {:>14} {:>7} {:>8} {:>18}\n", "table", "agent", "axis",
                    c.b + " worse", "p", "ratio", "95% interval");
   for (const auto& r : c.rows) {
     const std::string interval =
         std::isfinite(r.ratio_lo) ? fmt::format("[{:.2f}, {:.2f}]", r.ratio_lo, r.ratio_hi) : "-";
-    s += fmt::format("{:<8} {:<10} {:<4} {:>14} {:>7.3f} {:>8.2f} {:>18}\n",
-                     r.quantity == "table4" ? "4" : "5 final", r.agent, std::string(1, "xyz"[r.axis]),
+    const std::string table = r.quantity == "table5" ? "5 final" : r.phase.empty() ? "4" : "4 " + r.phase;
+    s += fmt::format("{:<16} {:<10} {:<4} {:>14} {:>7.3f} {:>8.2f} {:>18}\n", table, r.agent,
+                     std::string(1, "xyz"[r.axis]),
                      fmt::format("{} of {}", r.b_worse, r.seeds), r.sign_p, r.ratio, interval);
   }
   return s;
@@ -164,6 +202,7 @@ void write_paired(const std::vector<PairedComparison>& comparisons, const fs::pa
     for (const auto& r : c.rows)
       j["rows"].push_back({{"quantity", r.quantity},
                            {"agent", r.agent},
+                           {"phase", r.phase},
                            {"axis", std::string(1, "xyz"[r.axis])},
                            {"seeds", r.seeds},
                            {"b_worse", r.b_worse},

@@ -4,7 +4,8 @@
 // and axis of the Table 4 totals and per axis of Table 5's final landmark MSE, on how many seeds
 // B is worse than A, the exact two-sided sign test of "as often worse as better", and the
 // geometric-mean ratio B / A with a 95 % Student-t interval over the seeds' log ratios (MSEs are
-// skewed; their logs are close to normal, and a ratio reads the same for every axis).
+// skewed; their logs are close to normal, and a ratio reads the same for every axis). The same
+// per phase of Table 4 follows, since a difference in a total is often one phase's.
 #pragma once
 
 #include <filesystem>
@@ -18,6 +19,7 @@ namespace wingman::eval {
 struct PairedRow {
   std::string quantity;  // "table4" (an agent's total MSE) or "table5" (landmarks, final MSE)
   std::string agent;     // Table 4's agent; "landmarks" for Table 5
+  std::string phase;     // Table 4's phase name; empty for the totals and Table 5
   int axis = 0;          // 0, 1, 2: x, y, z
   int seeds = 0;         // seeds where both variants have the value
   int b_worse = 0;       // of which B's MSE is larger than A's
@@ -42,7 +44,8 @@ double student_t_quantile(double p, double dof);
 PairedRow compare_values(const std::vector<double>& a, const std::vector<double>& b);
 
 // Reads metrics.json of dirs_a[i] and dirs_b[i] (the same seed) for every i: Table 4's agents
-// that both variants have, in A's order, then Table 5. Throws std::runtime_error naming the file
+// that both variants have, in A's order, then Table 5, then Table 4 per phase of A's first seed
+// (matched by name; a seed without the phase or the agent there is left out of that row). Throws std::runtime_error naming the file
 // when one is missing or malformed, std::invalid_argument when the lists differ in length.
 PairedComparison compare_paired(const std::string& a, const std::vector<std::filesystem::path>& dirs_a,
                                 const std::string& b, const std::vector<std::filesystem::path>& dirs_b);

@@ -162,6 +162,9 @@ struct EstimatorSpec {
   // Cooperative initialisation (eq. 47-52).
   double min_parallax_deg = 3.0;
   double max_reprojection_px = 10.0;
+  // A pair that triangulates nearer than this to either camera (m, along its optical axis) is
+  // rejected as a wrong match; 0 keeps every point in front of both cameras.
+  double min_depth_m = 0.0;
   // A pair under min_parallax_deg becomes an inverse-depth landmark anchored at the first camera
   // and corrected with the second pixel, instead of being rejected.
   bool low_parallax_inverse_depth = false;

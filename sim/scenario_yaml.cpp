@@ -621,10 +621,11 @@ void parse_estimator(const Ctx& ctx, const Field& f, EstimatorSpec& e, Provenanc
   }
   if (auto initf = m.get("initialisation")) {
     MapView i(ctx, *initf,
-              {"min_parallax_deg", "max_reprojection_px", "low_parallax_inverse_depth",
+              {"min_parallax_deg", "max_reprojection_px", "min_depth_m", "low_parallax_inverse_depth",
                "monocular_fill", "inverse_depth_rho", "inverse_depth_sigma", "linearity_threshold"});
     num(ctx, i, "min_parallax_deg", e.min_parallax_deg, in(0, 90, false, true));
     num(ctx, i, "max_reprojection_px", e.max_reprojection_px, gt(0));
+    num(ctx, i, "min_depth_m", e.min_depth_m, ge(0));
     boolean(ctx, i, "low_parallax_inverse_depth", e.low_parallax_inverse_depth);
     boolean(ctx, i, "monocular_fill", e.monocular_fill);
     num(ctx, i, "inverse_depth_rho", e.inverse_depth_rho, gt(0));

@@ -107,6 +107,7 @@ InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& c
   if (!t) return {std::nullopt, "degenerate"};
   const Eigen::Vector3d pC_a = rig_a.R_CW * (t->point - x_a), pC_b = rig_b.R_CW * (t->point - x_b);
   if (pC_a.z() <= 0 || pC_b.z() <= 0) return {std::nullopt, "negative depth"};
+  if (pC_a.z() < cfg.min_depth_m || pC_b.z() < cfg.min_depth_m) return {std::nullopt, kTooClose};
   if (t->parallax_rad < cfg.min_parallax_deg * kPi / 180) return {std::nullopt, kLowParallax};
   if (!(t->reprojection_px <= cfg.max_reprojection_px)) return {std::nullopt, "reprojection"};
 

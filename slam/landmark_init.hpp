@@ -36,6 +36,10 @@ struct CooperativeInitSettings {
   double sigma_px = 3.0;
   double min_parallax_deg = 3.0;
   double max_reprojection_px = 10.0;
+  // A triangulated point nearer than this to either camera (along its optical axis, m) is a wrong
+  // pair: a match along the epipolar line that triangulates just under the cameras. 0 checks only
+  // that it lies in front of both (OpenVINS's min_dist plays the same part).
+  double min_depth_m = 0.0;
   // Below min_parallax_deg: an inverse-depth landmark from the pair
   // (initialise_cooperative_inverse_depth) instead of a rejection.
   bool low_parallax_inverse_depth = false;
@@ -43,6 +47,8 @@ struct CooperativeInitSettings {
 
 // The rejection reason of a pair under min_parallax_deg.
 inline constexpr const char* kLowParallax = "low parallax";
+// The rejection reason of a pair that triangulates nearer than min_depth_m.
+inline constexpr const char* kTooClose = "too close";
 
 // Triangulates, checks depth, parallax and reprojection, and augments the state (eq. 52).
 // Returns the new landmark's id, or the reason it was rejected.

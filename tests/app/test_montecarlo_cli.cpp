@@ -79,9 +79,12 @@ TEST(MonteCarloCli, ComparesTheVariantsSeedBySeed) {
   ASSERT_EQ(c.size(), 1u);
   EXPECT_EQ(c[0]["a"], "multi");
   EXPECT_EQ(c[0]["b"], "single");
-  ASSERT_EQ(c[0]["rows"].size(), 9u);  // lead, uav1 and the landmarks, x y z each
+  // lead, uav1 and the landmarks, x y z each, then lead and uav1 in each of smoke.yaml's 3 phases.
+  ASSERT_EQ(c[0]["rows"].size(), 9u + 18u);
   EXPECT_EQ(c[0]["rows"][0]["agent"], "lead");
   EXPECT_EQ(c[0]["rows"][8]["agent"], "landmarks");
+  EXPECT_EQ(c[0]["rows"][9]["agent"], "lead");
+  EXPECT_NE(c[0]["rows"][9]["phase"], "");
   for (const auto& row : c[0]["rows"]) {
     EXPECT_EQ(row["seeds"], 2);
     EXPECT_GT(row["ratio_b_over_a"].get<double>(), 0.0);

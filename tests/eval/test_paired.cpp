@@ -112,6 +112,8 @@ TEST(Paired, ReadsRunsAndComparesTheAgentsBothHave) {
   const std::string text = format_paired(c);
   EXPECT_NE(text.find("single against multi, paired over 4 seeds"), std::string::npos);
   EXPECT_NE(text.find("4 of 4"), std::string::npos);
+  // No phases in these files: the totals and Table 5 only.
+  EXPECT_EQ(text.find("4 config"), std::string::npos);
 
   write_paired({c}, tmp.path / "comparison.json");
   std::ifstream in(tmp.path / "comparison.json");
@@ -119,6 +121,53 @@ TEST(Paired, ReadsRunsAndComparesTheAgentsBothHave) {
   EXPECT_EQ(j[0]["b"], "single");
   EXPECT_EQ(j[0]["rows"].size(), 9u);
   EXPECT_NEAR(j[0]["rows"][0]["ratio_b_over_a"].get<double>(), 2.0, 1e-12);
+}
+
+// Table 4 per phase: matched by name, and a seed that lacks the phase or the agent in it is left
+// out of that row only.
+TEST(Paired, ComparesEachPhaseOfTable4) {
+  TempDir tmp;
+  std::vector<fs::path> a, b;
+  auto phase = [](const std::string& name, double lead_x, bool with_uav1) {
+    nlohmann::json p = {{"name", name}, {"agents", {{"lead", {{"mse", {lead_x, 1.0, 1.0}}}}}}};
+    if (with_uav1) p["agents"]["uav1"] = {{"mse", {1.0, 1.0, 1.0}}};
+    return p;
+  };
+  for (int s = 0; s < 3; ++s) {
+    a.push_back(tmp.path / std::to_string(s) / "multi");
+    b.push_back(tmp.path / std::to_string(s) / "single");
+    write_metrics(a.back(), {{"lead", {1, 1, 1}}, {"uav1", {1, 1, 1}}}, {1, 1, 1});
+    write_metrics(b.back(), {{"lead", {1, 1, 1}}, {"uav1", {1, 1, 1}}}, {1, 1, 1});
+    nlohmann::json ma = nlohmann::json::parse(std::ifstream(a.back() / "metrics.json"));
+    nlohmann::json mb = nlohmann::json::parse(std::ifstream(b.back() / "metrics.json"));
+    ma["table4"]["phases"] = {phase("config1", 1, true), phase("config3", 1, true)};
+    // B lists its phases in the other order; config3's lead x is 4x, config1's 0.5x; seed 2's
+    // config1 has no uav1.
+    mb["table4"]["phases"] = {phase("config3", 4, true), phase("config1", 0.5, s != 2)};
+    std::ofstream(a.back() / "metrics.json") << ma.dump();
+    std::ofstream(b.back() / "metrics.json") << mb.dump();
+  }
+  const PairedComparison c = compare_paired("multi", a, "single", b);
+  // 6 totals, 3 Table 5, then config1 and config3 for lead and uav1, 3 axes each.
+  ASSERT_EQ(c.rows.size(), 9u + 12u);
+  const PairedRow& c1_lead_x = c.rows[9];
+  EXPECT_EQ(c1_lead_x.phase, "config1");
+  EXPECT_EQ(c1_lead_x.agent, "lead");
+  EXPECT_EQ(c1_lead_x.seeds, 3);
+  EXPECT_NEAR(c1_lead_x.ratio, 0.5, 1e-12);
+  EXPECT_EQ(c.rows[12].agent, "uav1");
+  EXPECT_EQ(c.rows[12].seeds, 2);  // seed 2's config1 has no uav1 in B
+  const PairedRow& c3_lead_x = c.rows[15];
+  EXPECT_EQ(c3_lead_x.phase, "config3");
+  EXPECT_EQ(c3_lead_x.b_worse, 3);
+  EXPECT_NEAR(c3_lead_x.ratio, 4.0, 1e-12);
+  EXPECT_TRUE(c.rows[0].phase.empty());
+
+  const std::string text = format_paired(c);
+  EXPECT_NE(text.find("4 config3"), std::string::npos);
+  write_paired({c}, tmp.path / "comparison.json");
+  const auto j = nlohmann::json::parse(std::ifstream(tmp.path / "comparison.json"));
+  EXPECT_EQ(j[0]["rows"][15]["phase"], "config3");
 }
 
 TEST(Paired, MalformedRunsNameTheFile) {

@@ -89,7 +89,8 @@ estimator:
   gating: {probability: 0.99, one_point_ransac: false, ransac_inlier_px: 3,
            ransac_success_probability: 0.95, ransac_max_hypotheses: 50}
   map: {max_landmarks: 200, target_per_camera: 30, max_misses: 7, image_margin_px: 12}
-  initialisation: {min_parallax_deg: 2, max_reprojection_px: 8, low_parallax_inverse_depth: true,
+  initialisation: {min_parallax_deg: 2, max_reprojection_px: 8, min_depth_m: 4.5,
+                   low_parallax_inverse_depth: true,
                    inverse_depth_rho: 0.1, inverse_depth_sigma: 0.05, linearity_threshold: 0.2}
 variants:
   - name: multi
@@ -164,6 +165,7 @@ TEST(ScenarioYaml, FullDocumentParses) {
   EXPECT_EQ(s.estimator.target_landmarks_per_camera, 30);
   EXPECT_EQ(s.estimator.max_misses, 7);
   EXPECT_DOUBLE_EQ(s.estimator.min_parallax_deg, 2);
+  EXPECT_DOUBLE_EQ(s.estimator.min_depth_m, 4.5);
   EXPECT_TRUE(s.estimator.low_parallax_inverse_depth);
   EXPECT_DOUBLE_EQ(s.estimator.linearity_threshold, 0.2);
 
@@ -356,6 +358,8 @@ estimator:
               HasSubstr("uavs[0].camera.width: must be in [1, 16384], got 0"));
   EXPECT_THAT(error_of("estimator: {initialisation: {min_parallax_deg: 90}}\n"),
               HasSubstr("estimator.initialisation.min_parallax_deg: must be in [0, 90), got 90"));
+  EXPECT_THAT(error_of("estimator: {initialisation: {min_depth_m: -1}}\n"),
+              HasSubstr("estimator.initialisation.min_depth_m: must be >= 0, got -1"));
   EXPECT_THAT(error_of("estimator: {initialisation: {low_parallax_inverse_depth: 2}}\n"),
               HasSubstr("expected true or false, got '2'"));
   EXPECT_THAT(error_of("estimator: {map: {max_landmarks: 0}}\n"),

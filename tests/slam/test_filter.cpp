@@ -307,6 +307,32 @@ TEST(Estimator, MapCapEvictsLandmarksOutOfView) {
   EXPECT_EQ(est.end_step().size(), 3u);
 }
 
+// A wrong cooperative pair along the epipolar line triangulates just under the cameras (the
+// rendered paper scene's were 2-4 m under them); min_depth_m turns such a point away and keeps
+// a ground point 15 m down.
+TEST(Estimator, MinDepthRejectsAPointJustUnderTheCameras) {
+  const CameraRig rig = nadir_rig();
+  auto run = [&](double min_depth, const Eigen::Vector3d& p) {
+    EstimatorSettings cfg = Scene::settings(true);
+    cfg.cooperative.min_depth_m = min_depth;
+    Estimator est({rig, rig}, {}, {{Eigen::Vector3d(-1.5, 0, 15), Eigen::Vector3d::Zero()}, {Eigen::Vector3d(1.5, 0, 17), Eigen::Vector3d::Zero()}}, cfg);
+    const auto o = est.initialise_from_matches({{0, 1, *project_point(rig, est.camera_position(0), p),
+                                                 *project_point(rig, est.camera_position(1), p)}});
+    return std::make_pair(o[0], est.num_landmarks());
+  };
+  const Eigen::Vector3d near(0.5, 1.0, 12.0), ground(0.5, 1.0, 0.0);  // 3 m and 15 m under camera 0
+  const auto [near_off, n_off] = run(0.0, near);
+  EXPECT_TRUE(near_off.id) << near_off.rejected_because;
+  EXPECT_EQ(n_off, 1);
+  const auto [near_on, n_on] = run(5.0, near);
+  EXPECT_FALSE(near_on.id);
+  EXPECT_EQ(near_on.rejected_because, kTooClose);
+  EXPECT_EQ(n_on, 0);
+  const auto [ground_on, n_ground] = run(5.0, ground);
+  EXPECT_TRUE(ground_on.id) << ground_on.rejected_because;
+  EXPECT_EQ(n_ground, 1);
+}
+
 namespace {
 // Two nadir cameras 3.6 m apart and a ground point far to the side: 3.3 degrees of parallax.
 struct LowParallaxPair {
