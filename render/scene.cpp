@@ -307,7 +307,8 @@ constexpr double kCueLift = sim::kLeadCueLift;
 
 }  // namespace
 
-void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, Scene& scene) {
+void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, const Material& sampling,
+                     Scene& scene) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw std::runtime_error("lead model '" + path + "': file not found");
   Assimp::Importer importer;
@@ -347,6 +348,8 @@ void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, Sc
         m->GetTexture(aiTextureType_BASE_COLOR, 0, &tex) != AI_SUCCESS)
       continue;
     Material mat;
+    mat.anisotropy = sampling.anisotropy;
+    mat.trilinear = sampling.trilinear;
     if (const aiTexture* emb = ai->GetEmbeddedTexture(tex.C_Str())) {
       cv::Mat raw;
       if (emb->mHeight == 0) {
@@ -392,6 +395,8 @@ void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, Sc
   // The cue: a flat square centred on the reference point, kCueLift above the roof.
   if (spec.cue == sim::LeadModelSpec::Cue::None) return;
   Material cue;
+  cue.anisotropy = sampling.anisotropy;
+  cue.trilinear = sampling.trilinear;
   cue.repeat = false;
   cue.unlit = true;
   double side = spec.marker_size;
@@ -475,7 +480,7 @@ Scene build_scene(const sim::Scenario& scn) {
     scene.static_meshes.push_back(
         objects_mesh(objects, static_cast<int>(scene.materials.size()) - 1));
   }
-  load_lead_model(w.lead, resolve_asset(w.lead.model, scn.source_path, "lead model"), scene);
+  load_lead_model(w.lead, resolve_asset(w.lead.model, scn.source_path, "lead model"), ground, scene);
   return scene;
 }
 

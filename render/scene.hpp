@@ -61,8 +61,10 @@ std::string resolve_asset(const std::string& path, const std::string& scenario_p
 
 // The lead model from any format assimp reads, scaled to `height`, its up axis made z, its
 // top-centre moved to the origin; with the cue on its roof. Throws std::runtime_error naming the
-// file when it is missing, not a model, or refers to a missing texture.
-void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, Scene& scene);
+// file when it is missing, not a model, or refers to a missing texture. Its materials sample their
+// textures as `sampling` does (anisotropy, trilinear; build_scene passes the ground's).
+void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, const Material& sampling,
+                     Scene& scene);
 
 // The whole world of a scenario.
 Scene build_scene(const sim::Scenario& scn);

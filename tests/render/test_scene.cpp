@@ -58,13 +58,37 @@ TEST(Scene, LeadIsScaledToItsHeightAndSpansThirtyPixelsFromFifteenMetres) {
   EXPECT_GE(span_px, 30.0);
 }
 
+// world.texture's sampling reaches every texture, the lead's included: a lead left at the default
+// anisotropy 4 in a scene set to 1 cost one llvmpipe frame of the paper scene 16-25 s
+// (docs/rendering.md, Speed).
+TEST(Scene, EveryMaterialTakesTheWorldsTextureSampling) {
+  sim::Scenario scn = sim::load_scenarios(kPaper).front();
+  scn.world.texture.anisotropy = 1;
+  scn.world.texture.filter = sim::TextureSpec::Filter::Bilinear;
+  const Scene s = build_scene(scn);
+  ASSERT_GE(s.materials.size(), 4u);  // ground, objects, the truck's textures, the cue
+  int lead_textured = 0;
+  for (const auto& m : s.lead_meshes) lead_textured += m.material >= 0;
+  EXPECT_GT(lead_textured, 0);
+  for (std::size_t i = 0; i < s.materials.size(); ++i) {
+    EXPECT_EQ(s.materials[i].anisotropy, 1.0) << "material " << i;
+    EXPECT_FALSE(s.materials[i].trilinear) << "material " << i;
+  }
+  scn.world.texture.anisotropy = 8;
+  scn.world.texture.filter = sim::TextureSpec::Filter::Trilinear;
+  for (const auto& m : build_scene(scn).materials) {
+    EXPECT_EQ(m.anisotropy, 8.0);
+    EXPECT_TRUE(m.trilinear);
+  }
+}
+
 TEST(Scene, MissingModelNonModelAndMissingTextureAreErrorsNamingTheFile) {
   TempDir tmp;
   sim::LeadModelSpec spec;
   Scene s;
   const std::string missing = (tmp.path / "no_such_truck.glb").string();
   try {
-    load_lead_model(spec, missing, s);
+    load_lead_model(spec, missing, Material{}, s);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
@@ -73,7 +97,7 @@ TEST(Scene, MissingModelNonModelAndMissingTextureAreErrorsNamingTheFile) {
   const std::string junk = (tmp.path / "junk.glb").string();
   std::ofstream(junk) << "this is not a 3D model\n";
   try {
-    load_lead_model(spec, junk, s);
+    load_lead_model(spec, junk, Material{}, s);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(junk), std::string::npos) << e.what();
