@@ -215,14 +215,15 @@ int montecarlo_command(const MonteCarloOptions& o) {
     return 1;
   }
   std::vector<eval::MonteCarloSummary> summaries;
-  std::vector<std::pair<std::string, std::vector<fs::path>>> variant_dirs;
+  // Each run's metrics.json is read once, for the aggregate, the batches and the comparison.
+  std::vector<std::pair<std::string, eval::RunSet>> variant_runs;
   for (const auto& [label, sub] : variant_labels(scenarios)) {
     std::vector<fs::path> dirs;
     for (auto seed : finished) dirs.push_back(sub.empty() ? run_dir(out, seed) : run_dir(out, seed) / sub);
-    variant_dirs.emplace_back(label, dirs);
-    summaries.push_back(eval::aggregate_runs(label, dirs));
+    const eval::RunSet& runs = variant_runs.emplace_back(label, eval::RunSet(dirs)).second;
+    summaries.push_back(eval::aggregate_runs(label, runs));
     if (o.batch > 0 && dirs.size() >= static_cast<std::size_t>(o.batch)) {
-      eval::BatchTest bt = eval::test_batches(label, dirs, static_cast<std::size_t>(o.batch));
+      eval::BatchTest bt = eval::test_batches(label, runs, static_cast<std::size_t>(o.batch));
       for (auto& b : bt.batches)
         b.label = fmt::format("seeds {}-{}", finished[b.first], finished[b.first + b.size - 1]);
       summaries.back().batches = std::move(bt);
@@ -234,9 +235,9 @@ int montecarlo_command(const MonteCarloOptions& o) {
   eval::write_monte_carlo(summaries, out);
   // Every later variant against the first, seed by seed (the paper scenes: single against multi).
   std::vector<eval::PairedComparison> comparisons;
-  for (std::size_t v = 1; v < variant_dirs.size(); ++v)
-    comparisons.push_back(eval::compare_paired(variant_dirs[0].first, variant_dirs[0].second,
-                                               variant_dirs[v].first, variant_dirs[v].second));
+  for (std::size_t v = 1; v < variant_runs.size(); ++v)
+    comparisons.push_back(eval::compare_paired(variant_runs[0].first, variant_runs[0].second,
+                                               variant_runs[v].first, variant_runs[v].second));
   if (!comparisons.empty()) eval::write_paired(comparisons, out / "comparison.json");
   if (!o.no_plots) {
     fs::create_directories(out / "plots");

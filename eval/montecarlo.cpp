@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -105,11 +106,17 @@ double mean_nees_halfwidth95(const Spread& run_means) {
 
 MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs::path>& run_dirs) {
   if (run_dirs.empty()) throw std::runtime_error(fmt::format("{}: no finished runs", label));
+  return aggregate_runs(label, RunSet(run_dirs));
+}
+
+MonteCarloSummary aggregate_runs(const std::string& label, const RunSet& runs) {
+  if (runs.empty()) throw std::runtime_error(fmt::format("{}: no finished runs", label));
+  const std::vector<fs::path>& run_dirs = runs.dirs();
   MonteCarloSummary m;
   m.label = label;
   m.runs = static_cast<int>(run_dirs.size());
-  std::vector<json> metrics;
-  for (const auto& dir : run_dirs) metrics.push_back(read_json_file(dir / "metrics.json"));
+  std::vector<std::reference_wrapper<const json>> metrics;
+  for (std::size_t r = 0; r < runs.size(); ++r) metrics.emplace_back(run_metrics(runs, r));
   m.t = read_times(run_dirs.front() / "steps.csv");
   const std::size_t steps = m.t.size();
 
@@ -118,7 +125,7 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
   std::vector<int> count(steps, 0);
   std::vector<std::vector<double>> per_run(metrics.size(), std::vector<double>(steps, kNaN));
   for (std::size_t r = 0; r < metrics.size(); ++r) {
-    const auto& nees = metrics[r].at("nees");
+    const json& nees = metrics[r].get().at("nees");
     const auto& per_step = nees.at("per_step");
     if (per_step.size() != steps)
       throw std::runtime_error(fmt::format("{}: {} NEES steps, the first run has {}",
@@ -144,7 +151,7 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
 
   // Per phase (from the first run; every run of a variant shares them) and the whole run.
   std::vector<MonteCarloPhase> phases;
-  for (const auto& p : metrics.front().at("phases")) {
+  for (const auto& p : metrics.front().get().at("phases")) {
     MonteCarloPhase ph;
     ph.name = p.at("name").get<std::string>();
     ph.t_start = p.at("t_start").get<double>();
@@ -184,14 +191,14 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
   // Table 4 spreads; `pick` finds the agents' object: table4.phases[i].agents or table4.total.
   auto table4_spread = [&](MonteCarloPhase& ph, const json* (*pick)(const json&, std::size_t),
                            std::size_t index) {
-    const json* first = pick(metrics.front(), index);
+    const json* first = pick(metrics.front().get(), index);
     if (!first) return;
     for (auto it = first->begin(); it != first->end(); ++it) {
       AgentSpread a;
       a.agent = it.key();
       for (int axis = 0; axis < 3; ++axis) {
         std::vector<double> v;
-        for (const auto& mj : metrics)
+        for (const json& mj : metrics)
           if (const json* p = pick(mj, index); p && p->contains(a.agent))
             v.push_back(number_or_nan(p->at(a.agent).at("mse").at(axis)));
         a.mse[axis] = spread_of(v);
@@ -201,13 +208,13 @@ MonteCarloSummary aggregate_runs(const std::string& label, const std::vector<fs:
   };
   // Block NEES of phase `index`, from each run's nees.per_agent (absent in older metrics.json).
   auto block_nees = [&](MonteCarloPhase& ph, std::size_t index) {
-    const json& first = metrics.front().at("nees");
+    const json& first = metrics.front().get().at("nees");
     if (!first.contains("per_agent")) return;
     for (auto it = first.at("per_agent").begin(); it != first.at("per_agent").end(); ++it) {
       BlockNees b;
       b.agent = it.key();
       std::vector<double> pos, vel;
-      for (const auto& mj : metrics) {
+      for (const json& mj : metrics) {
         const json& n = mj.at("nees");
         if (!n.contains("per_agent") || !n.at("per_agent").contains(b.agent)) continue;
         const json& a = n.at("per_agent").at(b.agent);
@@ -259,13 +266,20 @@ BatchTest test_batches(const std::string& label, const std::vector<fs::path>& ru
     throw std::invalid_argument(fmt::format("{}: batches of {} runs need at least {} runs and 2 per "
                                             "batch; {} finished", label, batch_size,
                                             std::max<std::size_t>(batch_size, 2), run_dirs.size()));
+  return test_batches(label, RunSet(run_dirs), batch_size);
+}
+
+BatchTest test_batches(const std::string& label, const RunSet& runs, std::size_t batch_size) {
+  const std::vector<fs::path>& run_dirs = runs.dirs();
+  if (batch_size < 2 || run_dirs.size() < batch_size)
+    throw std::invalid_argument(fmt::format("{}: batches of {} runs need at least {} runs and 2 per "
+                                            "batch; {} finished", label, batch_size,
+                                            std::max<std::size_t>(batch_size, 2), run_dirs.size()));
   BatchTest bt;
   bt.batch_size = batch_size;
   std::vector<double> p_pass;
   for (std::size_t first = 0; first + batch_size <= run_dirs.size(); first += batch_size) {
-    const std::vector<fs::path> dirs(run_dirs.begin() + static_cast<std::ptrdiff_t>(first),
-                                     run_dirs.begin() + static_cast<std::ptrdiff_t>(first + batch_size));
-    const MonteCarloSummary m = aggregate_runs(label, dirs);
+    const MonteCarloSummary m = aggregate_runs(label, runs.slice(first, batch_size));
     Batch b;
     b.first = first;
     b.size = batch_size;

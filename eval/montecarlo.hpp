@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "eval/run_record.hpp"
+#include "eval/run_set.hpp"
 
 namespace wingman::eval {
 
@@ -103,12 +104,15 @@ double poisson_binomial_cdf(const std::vector<double>& p, int k);
 // left out, and tests each. Throws std::invalid_argument when fewer than one batch fits.
 BatchTest test_batches(const std::string& label, const std::vector<std::filesystem::path>& run_dirs,
                        std::size_t batch_size);
+// The same on runs already read (no file is read again but the first run's steps.csv per batch).
+BatchTest test_batches(const std::string& label, const RunSet& runs, std::size_t batch_size);
 
 // Aggregates the results directories of N runs of one variant (each holding metrics.json and
 // steps.csv). Throws std::runtime_error naming the file when one is missing or malformed, or
 // when the runs do not have the same steps.
 MonteCarloSummary aggregate_runs(const std::string& label,
                                  const std::vector<std::filesystem::path>& run_dirs);
+MonteCarloSummary aggregate_runs(const std::string& label, const RunSet& runs);
 
 // montecarlo.json (every summary), nees.csv (t and, per summary, average NEES and bounds).
 void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries,

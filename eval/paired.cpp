@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -15,8 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-json read_metrics(const fs::path& dir) { return read_json_file(dir / "metrics.json"); }
 
 // The three numbers at j[keys...], or a runtime_error naming the file and the key.
 std::vector<double> triple(const json& j, const std::vector<std::string>& keys, const fs::path& dir) {
@@ -102,20 +102,41 @@ PairedComparison compare_paired(const std::string& a, const std::vector<fs::path
   if (dirs_a.size() != dirs_b.size())
     throw std::invalid_argument(fmt::format("compare_paired: {} runs of {} against {} of {}", dirs_a.size(),
                                             a, dirs_b.size(), b));
+  return compare_paired(a, RunSet(dirs_a), b, RunSet(dirs_b));
+}
+
+PairedComparison compare_paired(const std::string& a, const RunSet& runs_a, const std::string& b,
+                                const RunSet& runs_b) {
+  const std::vector<fs::path>& dirs_a = runs_a.dirs();
+  const std::vector<fs::path>& dirs_b = runs_b.dirs();
+  if (dirs_a.size() != dirs_b.size())
+    throw std::invalid_argument(fmt::format("compare_paired: {} runs of {} against {} of {}", dirs_a.size(),
+                                            a, dirs_b.size(), b));
   PairedComparison c{a, b, static_cast<int>(dirs_a.size()), {}};
   if (dirs_a.empty()) return c;
-  std::vector<json> ja, jb;
+  std::vector<std::reference_wrapper<const json>> ja, jb;
   for (std::size_t i = 0; i < dirs_a.size(); ++i) {
-    ja.push_back(read_metrics(dirs_a[i]));
-    jb.push_back(read_metrics(dirs_b[i]));
+    ja.emplace_back(run_metrics(runs_a, i));
+    jb.emplace_back(run_metrics(runs_b, i));
   }
+  // j[k1][k2]..., or null where a key is missing (json's const operator[] must not be given one).
+  static const json kNull;
+  auto at_path = [](const json& j, std::initializer_list<const char*> keys) -> const json& {
+    const json* p = &j;
+    for (const char* k : keys) {
+      if (!p->is_object() || !p->contains(k)) return kNull;
+      p = &(*p)[k];
+    }
+    return *p;
+  };
   // Table 4's agents of A (in its order) that B has too, read from the first seed.
   std::vector<std::string> agents;
-  const auto& total = ja.front()["table4"]["total"];
+  const json& total = at_path(ja.front(), {"table4", "total"});
   if (!total.is_object())
     throw std::runtime_error(fmt::format("{}: no 'table4.total'", (dirs_a.front() / "metrics.json").string()));
   for (const auto& [agent, v] : total.items())
-    if (jb.front()["table4"]["total"].contains(agent)) agents.push_back(agent);
+    if (const json& tb = at_path(jb.front(), {"table4", "total"}); tb.is_object() && tb.contains(agent))
+      agents.push_back(agent);
   // nlohmann's object keys are sorted; put the lead first, as the tables do.
   std::stable_partition(agents.begin(), agents.end(), [](const std::string& s) { return s == "lead"; });
 
@@ -156,7 +177,7 @@ PairedComparison compare_paired(const std::string& a, const std::vector<fs::path
     return v;
   };
   std::vector<std::string> phase_names;
-  if (const json& t4 = ja.front()["table4"]; t4.contains("phases") && t4["phases"].is_array())
+  if (const json& t4 = at_path(ja.front(), {"table4"}); t4.is_object() && t4.contains("phases") && t4["phases"].is_array())
     for (const auto& ph : t4["phases"])
       if (ph.is_object() && ph.contains("name") && ph["name"].is_string()) phase_names.push_back(ph["name"]);
   for (const auto& name : phase_names)

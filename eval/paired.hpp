@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "eval/run_record.hpp"
+#include "eval/run_set.hpp"
 
 namespace wingman::eval {
 
@@ -49,6 +50,9 @@ PairedRow compare_values(const std::vector<double>& a, const std::vector<double>
 // when one is missing or malformed, std::invalid_argument when the lists differ in length.
 PairedComparison compare_paired(const std::string& a, const std::vector<std::filesystem::path>& dirs_a,
                                 const std::string& b, const std::vector<std::filesystem::path>& dirs_b);
+// The same on runs already read.
+PairedComparison compare_paired(const std::string& a, const RunSet& runs_a, const std::string& b,
+                                const RunSet& runs_b);
 
 // A readable table of one comparison.
 std::string format_paired(const PairedComparison& c);

@@ -221,3 +221,48 @@ TEST(MonteCarlo, BatchesEachAgainstTheirOwnBounds) {
 
   EXPECT_THROW(test_batches("multi", {dirs[0]}, 2), std::invalid_argument);
 }
+
+// A RunSet reads each metrics.json once: with the files gone afterwards, the aggregate and the
+// batch test from it equal those read from the directories, and a slice is its runs' own set.
+TEST(MonteCarlo, RunSetReadsEachMetricsFileOnce) {
+  TempDir tmp;
+  const auto dirs = write_chi2_runs(tmp.path, 6, 11, [](int r, int) { return r == 4 ? 3.0 : 1.0; });
+  const MonteCarloSummary from_dirs = aggregate_runs("multi", dirs);
+  const BatchTest batches_from_dirs = test_batches("multi", dirs, 2);
+  const MonteCarloSummary last_two = aggregate_runs("multi", {dirs[4], dirs[5]});
+
+  const RunSet runs(dirs);
+  for (const auto& d : dirs) fs::remove(d / "metrics.json");
+  ASSERT_EQ(runs.size(), 6u);
+  const MonteCarloSummary m = aggregate_runs("multi", runs);
+  ASSERT_EQ(m.average_nees.size(), from_dirs.average_nees.size());
+  for (std::size_t k = 1; k < m.average_nees.size(); ++k)
+    EXPECT_DOUBLE_EQ(m.average_nees[k], from_dirs.average_nees[k]) << k;
+  ASSERT_EQ(m.phases.size(), from_dirs.phases.size());
+  for (std::size_t i = 0; i < m.phases.size(); ++i)
+    EXPECT_DOUBLE_EQ(m.phases[i].fraction_inside, from_dirs.phases[i].fraction_inside);
+
+  const BatchTest bt = test_batches("multi", runs, 2);
+  ASSERT_EQ(bt.batches.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t p = 0; p < 2; ++p)
+      EXPECT_DOUBLE_EQ(bt.batches[i].fraction_inside[p], batches_from_dirs.batches[i].fraction_inside[p]);
+  EXPECT_EQ(bt.passed, batches_from_dirs.passed);
+
+  const RunSet tail = runs.slice(4, 2);
+  ASSERT_EQ(tail.size(), 2u);
+  EXPECT_EQ(tail.dir(0), dirs[4]);
+  const MonteCarloSummary t = aggregate_runs("multi", tail);
+  EXPECT_DOUBLE_EQ(t.phases[1].mean_nees, last_two.phases[1].mean_nees);
+  // Run 4's NEES x 3 is in the slice: about 12 against the six runs' 8.
+  EXPECT_GT(t.phases[1].mean_nees, 1.3 * m.phases[1].mean_nees);
+  EXPECT_THROW(runs.slice(5, 2), std::out_of_range);
+
+  // Reading: the missing file is named.
+  try {
+    RunSet again(dirs);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find((dirs[0] / "metrics.json").string()), std::string::npos) << e.what();
+  }
+}

@@ -95,6 +95,21 @@ TEST(Paired, ReadsRunsAndComparesTheAgentsBothHave) {
   const PairedComparison c = compare_paired("multi", a, "single", b);
   EXPECT_EQ(c.seeds, 4);
   ASSERT_EQ(c.rows.size(), 9u);  // lead, uav1 (uav2 is multi's only), landmarks; 3 axes each
+  {
+    // From runs already read (`wingman montecarlo` reads each file once): the same rows, with the
+    // files gone.
+    const RunSet ra(a), rb(b);
+    for (const auto& d : a) fs::remove(d / "metrics.json");
+    for (const auto& d : b) fs::remove(d / "metrics.json");
+    const PairedComparison again = compare_paired("multi", ra, "single", rb);
+    ASSERT_EQ(again.rows.size(), c.rows.size());
+    for (std::size_t i = 0; i < c.rows.size(); ++i) {
+      EXPECT_EQ(again.rows[i].agent, c.rows[i].agent);
+      EXPECT_EQ(again.rows[i].b_worse, c.rows[i].b_worse);
+      EXPECT_DOUBLE_EQ(again.rows[i].ratio, c.rows[i].ratio);
+    }
+    EXPECT_THROW(compare_paired("multi", ra, "single", rb.slice(0, 3)), std::invalid_argument);
+  }
   EXPECT_EQ(c.rows[0].agent, "lead");
   EXPECT_EQ(c.rows[3].agent, "uav1");
   EXPECT_EQ(c.rows[6].agent, "landmarks");
