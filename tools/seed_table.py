@@ -6,9 +6,15 @@ RESULTS_ROOT holds one results directory per seed (seed1/, seed2/, ...), each wi
 subdirectory per variant as `wingman run` writes them (the runs/ folder of `wingman montecarlo`
 has that layout). Prints, per variant, Table 4 and Table 5 totals for every seed and their mean,
 min and max; with two or more variants, also on how many seeds the first variant has the lower
-Table 4 total than each other one, per axis and on all six at once.
+Table 4 total than each other one, per axis and on all six at once; and per seed, the share of
+outliers among the tracked correspondences each variant's filter accepted (Table 3, every
+channel but the cooperative one), the cooperative landmarks initialised and the outliers among
+them, the axes of Tables 4 and 5 above the paper's multi-UAV row (DESIGN.md §9), and the largest
+distance of a landmark's final estimate from its truth (landmarks.csv).
 """
+import csv
 import json
+import math
 import statistics
 import sys
 from pathlib import Path
@@ -19,8 +25,22 @@ def load(root, variant):
     for d in sorted(Path(root).iterdir(), key=lambda p: (len(p.name), p.name)):
         f = d / variant / "metrics.json"
         if f.is_file():
-            runs.append((d.name, json.loads(f.read_text())))
+            m = json.loads(f.read_text())
+            m["_worst_landmark_m"] = worst_landmark(d / variant / "landmarks.csv")
+            runs.append((d.name, m))
     return runs
+
+
+def worst_landmark(path):
+    """Largest distance of a landmark's final estimate (or at removal) from its truth, m."""
+    if not path.is_file():
+        return float("nan")
+    worst = 0.0
+    with path.open() as f:
+        for r in csv.DictReader(f):
+            d = math.dist([float(r[f"final_{a}"]) for a in "xyz"], [float(r[f"truth_{a}"]) for a in "xyz"])
+            worst = max(worst, d)
+    return worst
 
 
 def table4_totals(m):
@@ -35,6 +55,22 @@ def paired_counts(first_runs, other_runs):
     wins = [[x < y for x, y in zip(table4_totals(a[s]), table4_totals(b[s]))] for s in seeds]
     per_axis = [sum(col) for col in zip(*wins)] if wins else [0] * 6
     return per_axis, sum(all(w) for w in wins), len(seeds)
+
+
+# DESIGN.md §9: the paper's Table 4 totals, multi-UAV (Xh, Yh, Zh, X1, Y1, Z1) and Table 5 final.
+PAPER_MULTI_T4 = [0.1221, 0.1676, 0.0468, 0.7621, 0.4847, 0.0755]
+PAPER_MULTI_T5 = [0.4702, 0.4683, 1.2120]
+AXES = ["Xh", "Yh", "Zh", "X1", "Y1", "Z1"]
+
+
+def outliers(m):
+    """(accepted outlier share of the tracked channels, cooperative accepted, cooperative outliers)."""
+    tracked = [r for r in m["table3"] if r["channel"] != "cooperative"]
+    acc = sum(r["accepted"] for r in tracked)
+    bad = sum(r["outliers_accepted"] for r in tracked)
+    coop = [r for r in m["table3"] if r["channel"] == "cooperative"]
+    return (bad / acc if acc else float("nan"),
+            coop[0]["accepted"] if coop else None, coop[0]["outliers_accepted"] if coop else None)
 
 
 def row(name, values):
@@ -64,6 +100,25 @@ def main():
         print(row("**mean**", [statistics.fmean(c) for c in cols]))
         print(row("min", [min(c) for c in cols]))
         print(row("max", [max(c) for c in cols]))
+    print("\n#### per seed: outliers accepted, cooperative landmarks, above the paper's multi row\n")
+    print("| seed | " + " | ".join(f"{v}: outliers accepted | {v}: cooperative (outliers) | {v}: Table 4 above paper | "
+                                   f"{v}: Table 5 above paper | {v}: worst landmark (m)" for v in variants) + " |")
+    print("|---" * (1 + 5 * len(variants)) + "|")
+    by_seed = {v: dict(loaded[v]) for v in variants}
+    for name, _ in loaded[variants[0]]:
+        cells = []
+        for v in variants:
+            m = by_seed[v].get(name)
+            if m is None:
+                cells += ["—"] * 5
+                continue
+            share, coop, coop_bad = outliers(m)
+            above4 = [a for a, x, ref in zip(AXES, table4_totals(m), PAPER_MULTI_T4) if x > ref]
+            above5 = [a for a, x, ref in zip("XYZ", m["table5"]["total"]["final_mse"], PAPER_MULTI_T5)
+                      if x is not None and x > ref]
+            cells += [f"{100 * share:.2f} %", "—" if coop is None else f"{coop} ({coop_bad})",
+                      ", ".join(above4) or "none", ", ".join(above5) or "none", f"{m['_worst_landmark_m']:.1f}"]
+        print(f"| {name} | " + " | ".join(cells) + " |")
     for other in variants[1:]:
         per_axis, all_six, n = paired_counts(loaded[variants[0]], loaded[other])
         print(f"\n#### seeds where {variants[0]} has the lower Table 4 total than {other} (of {n})\n")
