@@ -45,6 +45,13 @@ std::vector<double> read_times(const fs::path& path) {
   return t;
 }
 
+void check_batch_size(const std::string& label, std::size_t runs, std::size_t batch_size) {
+  if (batch_size < 2 || runs < batch_size)
+    throw std::invalid_argument(fmt::format("{}: batches of {} runs need at least {} runs and 2 per "
+                                            "batch; {} finished", label, batch_size,
+                                            std::max<std::size_t>(batch_size, 2), runs));
+}
+
 double number_or_nan(const json& j) { return j.is_number() ? j.get<double>() : kNaN; }
 
 // What an exactly consistent filter would show (eval/nees_null.hpp), from the runs' NEES
@@ -262,19 +269,13 @@ double poisson_binomial_cdf(const std::vector<double>& p, int k) {
 
 BatchTest test_batches(const std::string& label, const std::vector<fs::path>& run_dirs,
                        std::size_t batch_size) {
-  if (batch_size < 2 || run_dirs.size() < batch_size)
-    throw std::invalid_argument(fmt::format("{}: batches of {} runs need at least {} runs and 2 per "
-                                            "batch; {} finished", label, batch_size,
-                                            std::max<std::size_t>(batch_size, 2), run_dirs.size()));
+  check_batch_size(label, run_dirs.size(), batch_size);  // before reading any file
   return test_batches(label, RunSet(run_dirs), batch_size);
 }
 
 BatchTest test_batches(const std::string& label, const RunSet& runs, std::size_t batch_size) {
   const std::vector<fs::path>& run_dirs = runs.dirs();
-  if (batch_size < 2 || run_dirs.size() < batch_size)
-    throw std::invalid_argument(fmt::format("{}: batches of {} runs need at least {} runs and 2 per "
-                                            "batch; {} finished", label, batch_size,
-                                            std::max<std::size_t>(batch_size, 2), run_dirs.size()));
+  check_batch_size(label, run_dirs.size(), batch_size);
   BatchTest bt;
   bt.batch_size = batch_size;
   std::vector<double> p_pass;

@@ -1,6 +1,6 @@
 // The finished runs of one variant with each run's metrics.json parsed once: aggregate_runs,
-// test_batches and compare_paired all read the same files, which for a 400-run Monte Carlo
-// directory took tens of seconds per pass. Slices share the parsed files.
+// test_batches (once per batch) and compare_paired all read the same files, which they used to
+// read and parse again each time. Slices share the parsed files.
 #pragma once
 
 #include <cstddef>
