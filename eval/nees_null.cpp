@@ -63,6 +63,9 @@ ConsistentFilterInside simulate_consistent_inside(const Autoregression& ar, std:
   out.median.assign(ranges.size(), 0.0);
   out.p_below.assign(ranges.size(), 0.0);
   if (sims <= 0 || steps == 0) return out;
+  for (const auto& range : ranges)
+    for (std::size_t k : range)
+      if (k >= steps) throw std::out_of_range("simulate_consistent_inside: a range step is past `steps`");
   const std::size_t p = ar.phi.size();
   const std::size_t burn_in = 3 * p + 1;
   const std::size_t n = burn_in + steps;
@@ -95,10 +98,7 @@ ConsistentFilterInside simulate_consistent_inside(const Autoregression& ar, std:
       for (std::size_t r = 0; r < ranges.size(); ++r) {
         if (ranges[r].empty()) continue;
         int inside = 0;
-        for (std::size_t k : ranges[r]) {
-          if (burn_in + k >= n) throw std::out_of_range("simulate_consistent_inside: a range step is past `steps`");
-          inside += std::abs(z[(burn_in + k) * kLanes + j]) <= kZ975;
-        }
+        for (std::size_t k : ranges[r]) inside += std::abs(z[(burn_in + k) * kLanes + j]) <= kZ975;
         const double f = static_cast<double>(inside) / static_cast<double>(ranges[r].size());
         fractions[r].push_back(f);
         if (f < target) {

@@ -18,6 +18,11 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+void check_same_seeds(const std::string& a, std::size_t n_a, const std::string& b, std::size_t n_b) {
+  if (n_a != n_b)
+    throw std::invalid_argument(fmt::format("compare_paired: {} runs of {} against {} of {}", n_a, a, n_b, b));
+}
+
 // The three numbers at j[keys...], or a runtime_error naming the file and the key.
 std::vector<double> triple(const json& j, const std::vector<std::string>& keys, const fs::path& dir) {
   const json* p = &j;
@@ -99,19 +104,15 @@ PairedRow compare_values(const std::vector<double>& a, const std::vector<double>
 
 PairedComparison compare_paired(const std::string& a, const std::vector<fs::path>& dirs_a,
                                 const std::string& b, const std::vector<fs::path>& dirs_b) {
-  if (dirs_a.size() != dirs_b.size())
-    throw std::invalid_argument(fmt::format("compare_paired: {} runs of {} against {} of {}", dirs_a.size(),
-                                            a, dirs_b.size(), b));
-  return compare_paired(a, RunSet(dirs_a), b, RunSet(dirs_b));
+  check_same_seeds(a, dirs_a.size(), b, dirs_b.size());
+  return compare_paired(a, RunSet(dirs_a), b, RunSet(dirs_b));  // checked before reading any file
 }
 
 PairedComparison compare_paired(const std::string& a, const RunSet& runs_a, const std::string& b,
                                 const RunSet& runs_b) {
   const std::vector<fs::path>& dirs_a = runs_a.dirs();
   const std::vector<fs::path>& dirs_b = runs_b.dirs();
-  if (dirs_a.size() != dirs_b.size())
-    throw std::invalid_argument(fmt::format("compare_paired: {} runs of {} against {} of {}", dirs_a.size(),
-                                            a, dirs_b.size(), b));
+  check_same_seeds(a, dirs_a.size(), b, dirs_b.size());
   PairedComparison c{a, b, static_cast<int>(dirs_a.size()), {}};
   if (dirs_a.empty()) return c;
   std::vector<std::reference_wrapper<const json>> ja, jb;
