@@ -105,6 +105,21 @@ float intensity_centroid_angle(const cv::Mat& grey, cv::Point2f pt) {
 
 }  // namespace
 
+void orb_keypoints_to_pixel_centres(std::vector<cv::KeyPoint>& keypoints, cv::Size image,
+                                    float scale_factor) {
+  for (auto& k : keypoints) {
+    if (k.octave <= 0) continue;
+    // OpenCV's ORB: level L is the image resized (pixel centres aligned) to
+    // cvRound(size / s), s = (float) scale_factor^L, and a keypoint's level coordinates are
+    // reported times s. Undo that and map them back exactly: x0 = (xL + 0.5) W / W_L - 0.5.
+    const float s = static_cast<float>(std::pow(static_cast<double>(scale_factor), k.octave));
+    const int wl = cvRound(image.width / s), hl = cvRound(image.height / s);
+    const double xl = k.pt.x / s, yl = k.pt.y / s;
+    k.pt.x = static_cast<float>((xl + 0.5) * image.width / wl - 0.5);
+    k.pt.y = static_cast<float>((yl + 0.5) * image.height / hl - 0.5);
+  }
+}
+
 std::vector<cv::KeyPoint> bucket_keypoints(const std::vector<cv::KeyPoint>& keypoints, int width,
                                            int height, int grid_cols, int grid_rows, int budget) {
   std::vector<cv::KeyPoint> out;
@@ -185,6 +200,9 @@ Features FeatureExtractor::detect(const cv::Mat& image, const std::vector<Exclus
       }
     }
     describer_->compute(grey, kps, f.descriptors);  // drops keypoints too close to the border
+    // After describing: ORB's compute locates the patch from its own (level-scaled) coordinates.
+    if (cfg_.kind == DetectorKind::Orb)
+      orb_keypoints_to_pixel_centres(kps, grey.size(), cfg_.orb_scale_factor);
     f.keypoints = std::move(kps);
   } else {
     // Scale-space detectors: describing the surplus is cheaper than building the pyramid twice.
