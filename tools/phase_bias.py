@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Systematic error per phase over seeds, from wingman results directories.
+
+usage: tools/phase_bias.py RESULTS_ROOT VARIANT [VARIANT ...]
+RESULTS_ROOT holds one results directory per seed (seed1/, seed2/, ...), each with one
+subdirectory per variant (the runs/ folder of `wingman montecarlo` has that layout).
+
+Prints, per variant and phase, for the lead and Quad 1 (uav1) on each axis: the mean over seeds
+of the run's mean signed error (estimate minus truth, steps.csv), the standard deviation of that
+per-seed mean, the mean MSE, and the filter's own σ there (the root of the mean of
+`<agent>_s<axis>` squared, over every step of every seed) beside the RMS error it describes. A mean far from zero against its spread is an error every seed
+shares: a bias, not drift that one draw decides. Then the median signed error of the landmarks
+initialised in each phase (landmarks.csv), at initialisation and at the end, per axis: a
+landmark map that sits too near the cameras shows as a positive z there.
+"""
+import csv
+import math
+import statistics
+import sys
+from pathlib import Path
+
+
+def seed_dirs(root, variant):
+    dirs = [d / variant for d in Path(root).iterdir() if (d / variant / "steps.csv").is_file()]
+    return sorted(dirs, key=lambda p: (len(p.parent.name), p.parent.name))
+
+
+def agent_table(dirs, agents=("lead", "uav1")):
+    per = {}  # (phase, agent, axis) -> [(mean signed error, mse) per seed]
+    for d in dirs:
+        acc = {}
+        with (d / "steps.csv").open() as f:
+            for r in csv.DictReader(f):
+                if r["k"] == "0":
+                    continue  # the known initial state
+                for a in agents:
+                    for ax in "xyz":
+                        e = float(r[f"{a}_p{ax}_est"]) - float(r[f"{a}_p{ax}_true"])
+                        sig = float(r[f"{a}_s{ax}"])
+                        s = acc.setdefault((r["phase"], a, ax), [0, 0.0, 0.0, 0.0])
+                        s[0] += 1
+                        s[1] += e
+                        s[2] += e * e
+                        s[3] += sig * sig
+        for key, (n, se, se2, ss2) in acc.items():
+            per.setdefault(key, []).append((se / n, se2 / n, ss2 / n))
+    return per
+
+
+def landmark_table(dirs):
+    per = {}  # phase -> {"init": [[x], [y], [z]], "final": ...}
+    for d in dirs:
+        path = d / "landmarks.csv"
+        if not path.is_file():
+            continue
+        with path.open() as f:
+            for r in csv.DictReader(f):
+                t = per.setdefault(r["init_phase"], {"init": [[], [], []], "final": [[], [], []]})
+                for i, ax in enumerate("xyz"):
+                    truth = float(r[f"truth_{ax}"])
+                    for when in ("init", "final"):
+                        v = float(r[f"{when}_{ax}"])
+                        if math.isfinite(v):
+                            t[when][i].append(v - truth)
+    return per
+
+
+def main(argv):
+    if len(argv) < 3:
+        sys.exit(__doc__)
+    root = argv[1]
+    if not Path(root).is_dir():
+        sys.exit(f"{root}: not a directory")
+    for variant in argv[2:]:
+        dirs = seed_dirs(root, variant)
+        if not dirs:
+            sys.exit(f"{root}: no seed directory with {variant}/steps.csv")
+        print(f"#### {variant}: signed error per phase over {len(dirs)} seeds (m; MSE m²)\n")
+        print("| phase | agent | axis | mean signed error | sd over seeds | mean MSE | RMS error | filter σ |")
+        print("|---|---|---|---|---|---|---|---|")
+        per = agent_table(dirs)
+        for (phase, agent, axis), v in sorted(per.items()):
+            means = [m for m, _, _ in v]
+            sd = statistics.pstdev(means) if len(means) > 1 else float("nan")
+            mse = statistics.fmean(s for _, s, _ in v)
+            sigma = math.sqrt(statistics.fmean(s for _, _, s in v))
+            print(f"| {phase} | {agent} | {axis} | {statistics.fmean(means):+.3f} | {sd:.3f} | {mse:.4f} "
+                  f"| {math.sqrt(mse):.3f} | {sigma:.3f} |")
+        lm = landmark_table(dirs)
+        if lm:
+            print(f"\n#### {variant}: landmarks' median signed error by the phase they were initialised in (m)\n")
+            print("| phase | landmarks | init x | init y | init z | final x | final y | final z |")
+            print("|---|---|---|---|---|---|---|---|")
+            for phase, t in sorted(lm.items()):
+                med = [statistics.median(l) if l else float("nan") for l in t["init"] + t["final"]]
+                print(f"| {phase} | {len(t['init'][0])} | " + " | ".join(f"{m:+.3f}" for m in med) + " |")
+        print()
+
+
+if __name__ == "__main__":
+    main(sys.argv)
