@@ -7,6 +7,7 @@
 #include <set>
 
 #include "vision/cross_match.hpp"
+#include "vision/features.hpp"
 #include "vision/labelling.hpp"
 #include "vision_test_support.hpp"
 
@@ -122,6 +123,21 @@ TEST(CrossMatch, StillMatchesWithEstimatedPosesAndHonoursTheFreeLists) {
     inliers += label_pixel_pair(m.uv_a, v.a.camera, v.a.pose, da, m.uv_b, v.b.camera, v.b.pose, db).label ==
                Label::Inlier;
   EXPECT_GE(inliers, 0.95 * r.matches.size()) << inliers << " of " << r.matches.size();
+}
+
+TEST(CrossMatch, ACameraWithoutFeaturesMatchesNothingAndOtherKindsStillThrow) {
+  // A featureless view (a closed-loop UAV low over blurred ground) detects nothing: its
+  // descriptor matrix is empty and of no type, which must not read as another kind.
+  const TwoViews v;
+  const cv::Mat blank(480, 640, CV_8UC3, cv::Scalar(128, 128, 128));
+  const Features none = FeatureExtractor().detect(blank);
+  ASSERT_EQ(none.size(), 0);
+  EXPECT_TRUE(match_across(none, all_keypoints(none), v.a, v.fb, all_keypoints(v.fb), v.b).matches.empty());
+  EXPECT_TRUE(match_across(v.fa, all_keypoints(v.fa), v.a, none, all_keypoints(none), v.b).matches.empty());
+  FeatureSettings sift;
+  sift.kind = DetectorKind::Sift;
+  const Features fs = FeatureExtractor(sift).detect(v.scene.render(v.b));
+  EXPECT_THROW(match_across(v.fa, all_keypoints(v.fa), v.a, fs, all_keypoints(fs), v.b), std::invalid_argument);
 }
 
 TEST(CrossMatch, SelectSpreadFillsEmptyCellsFirstAndKeepsDistance) {
