@@ -8,8 +8,9 @@ subdirectory per variant (the runs/ folder of `wingman montecarlo` has that layo
 Prints, per variant and phase, for the lead and Quad 1 (uav1) on each axis: the mean over seeds
 of the run's mean signed error (estimate minus truth, steps.csv), the standard deviation of that
 per-seed mean, the mean MSE, and the filter's own σ there (the root of the mean of
-`<agent>_s<axis>` squared, over every step of every seed) beside the RMS error it describes. A mean far from zero against its spread is an error every seed
-shares: a bias, not drift that one draw decides. Then the median signed error of the landmarks
+`<agent>_s<axis>` squared, over every step of every seed) beside the RMS error it describes.
+A mean far from zero against its spread is an error every seed shares: a bias, not drift that
+one draw decides. Then the median signed error of the landmarks
 initialised in each phase (landmarks.csv), at initialisation and at the end, per axis: a
 landmark map that sits too near the cameras shows as a positive z there.
 """
@@ -26,7 +27,7 @@ def seed_dirs(root, variant):
 
 
 def agent_table(dirs, agents=("lead", "uav1")):
-    per = {}  # (phase, agent, axis) -> [(mean signed error, mse) per seed]
+    per = {}  # (phase, agent, axis) -> [(mean signed error, mse, mean σ²) per seed]
     for d in dirs:
         acc = {}
         with (d / "steps.csv").open() as f:
