@@ -135,11 +135,8 @@ CrossMatchResult match_across(const Features& fa, const std::vector<int>& free_a
                               const Features& fb, const std::vector<int>& free_b, const CameraView& b,
                               const CrossMatchSettings& cfg) {
   cfg.validate();
-  // A camera without features (a featureless view) has an empty descriptor matrix of no type:
-  // it matches nothing rather than mismatching kinds.
-  const bool both_described = !fa.descriptors.empty() && !fb.descriptors.empty();
-  if (fa.norm != fb.norm || (both_described && (fa.descriptors.type() != fb.descriptors.type() ||
-                                                 fa.descriptors.cols != fb.descriptors.cols)))
+  if (fa.norm != fb.norm || fa.descriptors.type() != fb.descriptors.type() ||
+      fa.descriptors.cols != fb.descriptors.cols)
     throw std::invalid_argument("match_across: the two cameras' descriptors are of different kinds");
   CrossMatchResult res;
   check_indices(free_a, fa.size(), "free_a");

@@ -154,6 +154,7 @@ FeatureExtractor::FeatureExtractor(const FeatureSettings& settings) : cfg_(setti
       detector_ = cv::SIFT::create(n, 3, cfg_.sift_contrast);
       break;
   }
+  if (!describer_) describer_ = detector_;  // AKAZE and SIFT describe what they detect
 }
 
 int FeatureExtractor::norm() const {
@@ -220,6 +221,11 @@ Features FeatureExtractor::detect(const cv::Mat& image, const std::vector<Exclus
       f.keypoints.push_back(in_kps[keep[r]]);
       desc.row(inside[keep[r]]).copyTo(f.descriptors.row(r));
     }
+  }
+  // No keypoint (a featureless view): OpenCV leaves the matrix without a type; give it the
+  // descriptor's kind and width, so that it still compares as the same kind as another camera's.
+  if (f.descriptors.empty()) {
+    f.descriptors = cv::Mat(0, describer_->descriptorSize(), describer_->descriptorType());
   }
   return f;
 }

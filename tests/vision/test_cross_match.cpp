@@ -126,12 +126,14 @@ TEST(CrossMatch, StillMatchesWithEstimatedPosesAndHonoursTheFreeLists) {
 }
 
 TEST(CrossMatch, ACameraWithoutFeaturesMatchesNothingAndOtherKindsStillThrow) {
-  // A featureless view (a closed-loop UAV low over blurred ground) detects nothing: its
-  // descriptor matrix is empty and of no type, which must not read as another kind.
+  // A featureless view (a closed-loop UAV low over blurred ground) detects nothing: its empty
+  // descriptor matrix keeps the detector's type and width, so it is not read as another kind.
   const TwoViews v;
   const cv::Mat blank(480, 640, CV_8UC3, cv::Scalar(128, 128, 128));
   const Features none = FeatureExtractor().detect(blank);
   ASSERT_EQ(none.size(), 0);
+  EXPECT_EQ(none.descriptors.type(), v.fb.descriptors.type());  // typed although empty
+  EXPECT_EQ(none.descriptors.cols, v.fb.descriptors.cols);
   EXPECT_TRUE(match_across(none, all_keypoints(none), v.a, v.fb, all_keypoints(v.fb), v.b).matches.empty());
   EXPECT_TRUE(match_across(v.fa, all_keypoints(v.fa), v.a, none, all_keypoints(none), v.b).matches.empty());
   FeatureSettings sift;

@@ -68,6 +68,12 @@ TEST_P(EveryDetector, FindsSpreadDescribedFeaturesOutsideTheExclusionBox) {
   // Bucketing: no cell is empty and none holds more than 2.5x its share.
   EXPECT_GT(*std::min_element(per_cell.begin(), per_cell.end()), 0);
   EXPECT_LE(*std::max_element(per_cell.begin(), per_cell.end()), 2.5 * 500 / 16);
+  // A featureless image: no keypoint, and descriptors of the same kind and width, none of them.
+  const Features none = fx.detect(cv::Mat(img.size(), img.type(), cv::Scalar::all(128)));
+  EXPECT_EQ(none.size(), 0);
+  EXPECT_EQ(none.descriptors.rows, 0);
+  EXPECT_EQ(none.descriptors.type(), f.descriptors.type()) << to_string(s.kind);
+  EXPECT_EQ(none.descriptors.cols, f.descriptors.cols) << to_string(s.kind);
 }
 
 INSTANTIATE_TEST_SUITE_P(Vision, EveryDetector,
