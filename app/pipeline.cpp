@@ -171,6 +171,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     rec.frontend.enabled = true;
     rec.frontend.detector = fe->detector_name();
     rec.frontend.renderer = fe->renderer_description();
+    rec.frontend.oracle_pixels = scn.frontend.oracle_pixels;
   }
 
   std::map<slam::LandmarkId, std::size_t> lm_record;  // filter id -> index in rec.landmarks

@@ -237,6 +237,7 @@ StageTimes RenderedFrontend::render_and_detect(const sim::Truth& truth, int k, d
       if (err <= fr.lead_match_px) {
         ++fr.lead_detected;
         fr.lead_error_px.push_back(err);
+        if (scn_.frontend.oracle_pixels) c.lead = *uv_true;
       } else {
         ++fr.lead_false;
       }
@@ -296,6 +297,11 @@ std::vector<LabelledCorrespondence> RenderedFrontend::track(
                                                          c.frame.depth);
       lc.outlier = lr.label != vision::Label::Inlier;
       lc.error_px = lr.reprojection_px;
+      if (scn_.frontend.oracle_pixels && !lc.outlier)
+        if (const auto uv = c.model.project(c.true_pose.to_camera(*it->second))) {
+          lc.c.uv = *uv;
+          lc.error_px = 0;
+        }
     }
     out.push_back(lc);
   }
@@ -334,6 +340,10 @@ std::vector<LabelledPair> RenderedFrontend::cross_match(int cam_a, int cam_b, in
     lp.outlier = vision::label_pixel_pair(m.uv_a, a.model, a.true_pose, a.frame.depth, m.uv_b,
                                           b.model, b.true_pose, b.frame.depth)
                      .label != vision::Label::Inlier;
+    // Camera a's pixel defines the landmark's truth (added()), so only b's is replaced.
+    if (scn_.frontend.oracle_pixels && !lp.outlier)
+      if (const auto X = vision::back_project(m.uv_a, a.model, a.true_pose, a.frame.depth))
+        if (const auto uv_b = b.model.project(b.true_pose.to_camera(*X))) lp.m.uv_b = *uv_b;
     out.push_back(lp);
   }
   return out;

@@ -87,6 +87,9 @@ struct FrontendRecord {
   bool enabled = false;
   std::string detector;   // feature detector, e.g. "orb"
   std::string renderer;   // GL context description
+  // frontend.oracle_pixels: correct correspondences carried their exact projections (a diagnostic
+  // run; its figures are not the frontend's).
+  bool oracle_pixels = false;
   long frames = 0;        // camera frames processed
   long lead_in_view = 0;  // frames whose true lead reference point projects inside the image
   long lead_detected = 0; // of those, frames with a detection within lead_match_px of the truth

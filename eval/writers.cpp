@@ -141,6 +141,7 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
     const FrontendMetrics& f = m.frontend;
     j["frontend"] = {{"detector", run.frontend.detector},
                      {"renderer", run.frontend.renderer},
+                     {"oracle_pixels", run.frontend.oracle_pixels},
                      {"frames", f.frames},
                      {"lead_in_view", f.lead_in_view},
                      {"lead_detected", f.lead_detected},
@@ -412,6 +413,10 @@ std::string format_summary(const Metrics& m, const RunRecord& run) {
                    cell(f.lead_error_px.median, 0, 3), cell(f.lead_error_px.p95, 0, 3), f.lead_false);
     fmt::format_to(out, "Accepted tracked correspondences to their true projection: median {} px, p95 {} px\n",
                    cell(f.accepted_error_px.median, 0, 3), cell(f.accepted_error_px.p95, 0, 3));
+    if (run.frontend.oracle_pixels)
+      fmt::format_to(out, "ORACLE PIXELS (frontend.oracle_pixels): correct correspondences and lead "
+                          "detections carried their exact projections; a diagnostic run, not the "
+                          "frontend's figures\n");
   }
   fmt::format_to(out, "Landmarks: {} initialised, at most {} in the state\n",
                  m.landmarks.initialised, m.landmarks.max_in_state);

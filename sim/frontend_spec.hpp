@@ -28,6 +28,12 @@ struct FrontendSpec {
   double cross_ratio = 0.8;
   double max_epipolar_px = 5.0;
   double max_reprojection_px = 5.0;
+  // Diagnostic ablation, never for reported figures: every correspondence the frontend got right
+  // (ground-truth label inlier; a detected lead within the match radius) reaches the estimator at
+  // its exact true projection instead of its measured pixel. Data association, wrong matches and
+  // what is found stay the frontend's, so the run separates the estimator's error from the pixel
+  // noise of detection (docs/pipeline_rendered.md).
+  bool oracle_pixels = false;
 };
 
 }  // namespace wingman::sim

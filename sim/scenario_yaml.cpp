@@ -870,7 +870,7 @@ void parse_world(const Ctx& ctx, const Field& f, WorldSpec& w) {
 // cross-UAV matching (rendered measurements; a synthetic run ignores it).
 void parse_frontend(const Ctx& ctx, const Field& f, FrontendSpec& fe) {
   MapView m(ctx, f, {"detector", "max_features", "grid", "orb", "akaze", "sift", "gftt", "tracking",
-                     "cross_matching"});
+                     "cross_matching", "oracle_pixels"});
   if (auto d = m.get("detector")) {
     static const std::vector<std::string_view> kinds = {"orb", "akaze", "sift", "gftt_orb"};
     const std::string& s = scalar_of(ctx, *d, "a detector name");
@@ -919,6 +919,7 @@ void parse_frontend(const Ctx& ctx, const Field& f, FrontendSpec& fe) {
     num(ctx, c, "max_epipolar_px", fe.max_epipolar_px, gt(0));
     num(ctx, c, "max_reprojection_px", fe.max_reprojection_px, gt(0));
   }
+  boolean(ctx, m, "oracle_pixels", fe.oracle_pixels);
 }
 
 // The sections a variant may override; the top level parses them with the same code.

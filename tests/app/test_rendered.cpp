@@ -11,6 +11,7 @@
 #include "app/pipeline.hpp"
 #include "app_test_support.hpp"
 #include "eval/metrics.hpp"
+#include "eval/writers.hpp"
 #include "render/gl_context.hpp"
 #include "sim/scenario.hpp"
 
@@ -112,6 +113,32 @@ TEST(RenderedPipeline, SingleUavBaselineRunsOnQuadOnesFramesAlone) {
   for (const auto& l : rec.landmarks) EXPECT_EQ(l.origin, "inverse_depth");
   ASSERT_EQ(rec.outliers.size(), 1u);  // Quad 1 only, no cooperative channel
   EXPECT_GT(rec.outliers[0].correspondences, 0);
+}
+
+// frontend.oracle_pixels: the frontend's correct correspondences reach the filter at their exact
+// projections (error 0), its wrong ones as they were; the run says so.
+TEST(RenderedPipeline, OraclePixelsFeedExactProjectionsOfCorrectCorrespondences) {
+  std::string why;
+  if (!gl_available(&why)) GTEST_SKIP() << why;
+  sim::Scenario s = variant("multi");
+  s.duration = 4;
+  s.frontend.oracle_pixels = true;
+  const auto rec = run_scenario(s, render::GlBackend::Auto);
+  EXPECT_TRUE(rec.frontend.oracle_pixels);
+  long accepted = 0, outliers_accepted = 0;
+  for (const auto& o : rec.outliers) {
+    if (o.channel == "cooperative") continue;
+    accepted += o.accepted;
+    outliers_accepted += o.outliers_accepted;
+  }
+  ASSERT_GT(accepted, 500);
+  ASSERT_EQ(static_cast<long>(rec.frontend.accepted_error_px.size()), accepted);
+  const long exact = std::count(rec.frontend.accepted_error_px.begin(),
+                                rec.frontend.accepted_error_px.end(), 0.0);
+  // Without the oracle the median is about 0.5 px and hardly any error is exactly 0.
+  EXPECT_EQ(exact, accepted - outliers_accepted);
+  const eval::Metrics m = eval::compute_metrics(rec);
+  EXPECT_THAT(eval::format_summary(m, rec), ::testing::HasSubstr("ORACLE PIXELS"));
 }
 
 // Rendering step k+1 during step k's detection changes when frames are made, not what they are:

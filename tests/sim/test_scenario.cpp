@@ -587,6 +587,7 @@ frontend:
   gftt: {quality: 0.01, min_distance_px: 7}
   tracking: {gate_d2: 11.8, ratio: 0.7, max_search_radius_px: 80, max_distance: 50, match_latest_descriptor: true}
   cross_matching: {ratio: 0.75, max_epipolar_px: 4, max_reprojection_px: 3}
+  oracle_pixels: true
 variants:
   - name: a
   - name: b
@@ -612,12 +613,14 @@ variants:
   EXPECT_DOUBLE_EQ(f.cross_ratio, 0.75);
   EXPECT_DOUBLE_EQ(f.max_epipolar_px, 4);
   EXPECT_DOUBLE_EQ(f.max_reprojection_px, 3);
+  EXPECT_TRUE(f.oracle_pixels);
   // The variant changes the detector and keeps the rest of the base section.
   EXPECT_EQ(v[1].frontend.detector, "akaze");
   EXPECT_DOUBLE_EQ(v[1].frontend.akaze_threshold, 0.001);
   EXPECT_EQ(v[1].frontend.max_features, 400);
   // Defaults without the section.
   EXPECT_EQ(parse_scenarios("measurements: rendered\n", "scn.yaml").front().frontend.detector, "orb");
+  EXPECT_FALSE(parse_scenarios("measurements: rendered\n", "scn.yaml").front().frontend.oracle_pixels);
 }
 
 TEST(ScenarioYaml, FrontendErrorsNameLineAndKey) {
@@ -654,6 +657,12 @@ frontend:
   orb: {levles: 3}
 )");
   EXPECT_THAT(error_of(unknown), HasSubstr("unknown key 'levles'"));
+
+  const std::string oracle = doc(R"(
+frontend:
+  oracle_pixels: 1
+)");
+  EXPECT_THAT(error_of(oracle), HasSubstr("frontend.oracle_pixels"));
 }
 
 TEST(ScenarioModel, SensorsOfFollowsTable1) {
