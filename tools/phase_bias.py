@@ -12,7 +12,9 @@ per-seed mean, the mean MSE, and the filter's own σ there (the root of the mean
 A mean far from zero against its spread is an error every seed shares: a bias, not drift that
 one draw decides. Then the median signed error of the landmarks
 initialised in each phase (landmarks.csv), at initialisation and at the end, per axis: a
-landmark map that sits too near the cameras shows as a positive z there.
+landmark map that sits too near the cameras shows as a positive z there. Between the two, per
+phase and agent: how far the estimate trails the truth in time, its speed's relative error, and
+how much its x error changed inside the phase (a drift, against an offset carried in).
 """
 import csv
 import math
@@ -45,6 +47,33 @@ def agent_table(dirs, agents=("lead", "uav1")):
                         s[3] += sig * sig
         for key, (n, se, se2, ss2) in acc.items():
             per.setdefault(key, []).append((se / n, se2 / n, ss2 / n))
+    return per
+
+
+def motion_table(dirs, agents=("lead", "uav1")):
+    """Per seed, phase and agent: the horizontal lag tau that best explains the position error as
+    -tau v (least squares over x and y), the speed's relative error (the velocity error along the
+    true velocity over |v|^2), and how much the x error changed from the phase's first step to its
+    last. An estimate that trails the truth has tau > 0; a drift inside a phase shows in the change."""
+    per = {}  # (phase, agent) -> [(tau, speed error, x change) per seed]
+    for d in dirs:
+        acc, ends = {}, {}
+        with (d / "steps.csv").open() as f:
+            for r in csv.DictReader(f):
+                if r["k"] == "0":
+                    continue
+                for a in agents:
+                    s = acc.setdefault((r["phase"], a), [0.0, 0.0, 0.0])
+                    for ax in "xy":
+                        v = float(r[f"{a}_v{ax}_true"])
+                        s[0] += (float(r[f"{a}_p{ax}_est"]) - float(r[f"{a}_p{ax}_true"])) * v
+                        s[1] += (float(r[f"{a}_v{ax}_est"]) - v) * v
+                        s[2] += v * v
+                    ex = float(r[f"{a}_px_est"]) - float(r[f"{a}_px_true"])
+                    ends.setdefault((r["phase"], a), [ex, ex])[1] = ex
+        for key, (ep, ev, vv) in acc.items():
+            first, last = ends[key]
+            per.setdefault(key, []).append((-ep / vv, ev / vv, last - first))
     return per
 
 
@@ -87,6 +116,16 @@ def main(argv):
             sigma = math.sqrt(statistics.fmean(s for _, _, s in v))
             print(f"| {phase} | {agent} | {axis} | {statistics.fmean(means):+.3f} | {sd:.3f} | {mse:.4f} "
                   f"| {math.sqrt(mse):.3f} | {sigma:.3f} |")
+        print(f"\n#### {variant}: lag, speed and drift per phase, mean over seeds (range)\n")
+        print("| phase | agent | lag τ (s) | speed error | x error change over the phase (m) |")
+        print("|---|---|---|---|---|")
+        for (phase, agent), v in sorted(motion_table(dirs).items()):
+            cells = []
+            for i, fmt in enumerate(("{:+.2f}", "{:+.2%}", "{:+.3f}")):
+                col = [x[i] for x in v]
+                cells.append(f"{fmt.format(statistics.fmean(col))} "
+                             f"({fmt.format(min(col))} to {fmt.format(max(col))})")
+            print(f"| {phase} | {agent} | " + " | ".join(cells) + " |")
         lm = landmark_table(dirs)
         if lm:
             print(f"\n#### {variant}: landmarks' median signed error by the phase they were initialised in (m)\n")
