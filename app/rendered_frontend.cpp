@@ -297,11 +297,10 @@ std::vector<LabelledCorrespondence> RenderedFrontend::track(
                                                          c.frame.depth);
       lc.outlier = lr.label != vision::Label::Inlier;
       lc.error_px = lr.reprojection_px;
-      if (scn_.frontend.oracle_pixels && !lc.outlier)
-        if (const auto uv = c.model.project(c.true_pose.to_camera(*it->second))) {
-          lc.c.uv = *uv;
-          lc.error_px = 0;
-        }
+      if (scn_.frontend.oracle_pixels && !lc.outlier) {  // an inlier has a true projection
+        lc.c.uv = *lr.true_uv;
+        lc.error_px = 0;
+      }
     }
     out.push_back(lc);
   }
@@ -337,13 +336,11 @@ std::vector<LabelledPair> RenderedFrontend::cross_match(int cam_a, int cam_b, in
     b.used[m.keypoint_b] = true;
     a.fresh.push_back(m.uv_a);
     b.fresh.push_back(m.uv_b);
-    lp.outlier = vision::label_pixel_pair(m.uv_a, a.model, a.true_pose, a.frame.depth, m.uv_b,
-                                          b.model, b.true_pose, b.frame.depth)
-                     .label != vision::Label::Inlier;
+    const auto lr = vision::label_pixel_pair(m.uv_a, a.model, a.true_pose, a.frame.depth, m.uv_b,
+                                             b.model, b.true_pose, b.frame.depth);
+    lp.outlier = lr.label != vision::Label::Inlier;
     // Camera a's pixel defines the landmark's truth (added()), so only b's is replaced.
-    if (scn_.frontend.oracle_pixels && !lp.outlier)
-      if (const auto X = vision::back_project(m.uv_a, a.model, a.true_pose, a.frame.depth))
-        if (const auto uv_b = b.model.project(b.true_pose.to_camera(*X))) lp.m.uv_b = *uv_b;
+    if (scn_.frontend.oracle_pixels && !lp.outlier) lp.m.uv_b = *lr.true_uv;
     out.push_back(lp);
   }
   return out;

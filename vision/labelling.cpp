@@ -48,6 +48,7 @@ LabelResult label_landmark_observation(const Eigen::Vector3d& point_W, const Eig
     r.reason = "behind camera";
     return r;
   }
+  r.true_uv = uv;
   r.reprojection_px = (*uv - observed_uv).norm();
   if (!cam.in_image(*uv)) {
     r.reason = "outside image";

@@ -27,6 +27,7 @@ enum class Label { Inlier, Outlier };
 struct LabelResult {
   Label label = Label::Outlier;
   double reprojection_px = 0;     // observed pixel to true projection (infinite when not projected)
+  std::optional<Eigen::Vector2d> true_uv;  // the true projection; nothing behind the camera
   bool depth_consistent = false;  // also true when no depth image was given
   const char* reason = "";        // why an outlier: "behind camera", "outside image", ...
 };

@@ -28,6 +28,8 @@ TEST(Labelling, CorrectObservationIsAnInlierAndWrongOnesAreOutliers) {
   const auto ok = label_landmark_observation(p, uv + Vector2d(1, -1), s.b.camera, s.b.pose, s.db);
   EXPECT_EQ(ok.label, Label::Inlier);
   EXPECT_NEAR(ok.reprojection_px, std::sqrt(2.0), 1e-9);
+  ASSERT_TRUE(ok.true_uv);
+  EXPECT_LT((*ok.true_uv - uv).norm(), 1e-9);
   EXPECT_TRUE(ok.depth_consistent);
 
   const auto off = label_landmark_observation(p, uv + Vector2d(6, 8), s.b.camera, s.b.pose, s.db);
@@ -42,7 +44,9 @@ TEST(Labelling, CorrectObservationIsAnInlierAndWrongOnesAreOutliers) {
   // Without a depth image only the pixel distance counts.
   EXPECT_EQ(label_landmark_observation(hidden, {100, 100}, s.b.camera, s.b.pose, cv::Mat()).label, Label::Inlier);
   // Behind the camera.
-  EXPECT_EQ(label_landmark_observation({0, 0, 30}, uv, s.b.camera, s.b.pose, s.db).label, Label::Outlier);
+  const auto behind = label_landmark_observation({0, 0, 30}, uv, s.b.camera, s.b.pose, s.db);
+  EXPECT_EQ(behind.label, Label::Outlier);
+  EXPECT_FALSE(behind.true_uv);
 }
 
 TEST(Labelling, PixelPairsAreLabelledThroughTheDepthOfTheFirstCamera) {
@@ -54,6 +58,8 @@ TEST(Labelling, PixelPairsAreLabelledThroughTheDepthOfTheFirstCamera) {
   const auto wrong = label_pixel_pair(ua, s.a.camera, s.a.pose, s.da, ub + Vector2d(4, 0), s.b.camera, s.b.pose, s.db);
   EXPECT_EQ(wrong.label, Label::Outlier);
   EXPECT_NEAR(wrong.reprojection_px, 4.0, 0.05);  // depth sampled at the nearest pixel centre
+  ASSERT_TRUE(wrong.true_uv);  // b's true projection of a's pixel, whatever b's pixel was
+  EXPECT_LT((*wrong.true_uv - ub).norm(), 0.05);
 
   // Millimetre depth gives the same answer.
   cv::Mat mm_a, mm_b;
