@@ -28,49 +28,49 @@ def seed_dirs(root, variant):
     return sorted(dirs, key=lambda p: (len(p.parent.name), p.parent.name))
 
 
-def agent_table(dirs, agents=("lead", "uav1")):
+def read_steps(d):
+    """steps.csv's rows after the known initial state (k = 0)."""
+    with (d / "steps.csv").open() as f:
+        return [r for r in csv.DictReader(f) if r["k"] != "0"]
+
+
+def agent_table(runs, agents=("lead", "uav1")):
     per = {}  # (phase, agent, axis) -> [(mean signed error, mse, mean σ²) per seed]
-    for d in dirs:
+    for rows in runs:
         acc = {}
-        with (d / "steps.csv").open() as f:
-            for r in csv.DictReader(f):
-                if r["k"] == "0":
-                    continue  # the known initial state
-                for a in agents:
-                    for ax in "xyz":
-                        e = float(r[f"{a}_p{ax}_est"]) - float(r[f"{a}_p{ax}_true"])
-                        sig = float(r[f"{a}_s{ax}"])
-                        s = acc.setdefault((r["phase"], a, ax), [0, 0.0, 0.0, 0.0])
-                        s[0] += 1
-                        s[1] += e
-                        s[2] += e * e
-                        s[3] += sig * sig
+        for r in rows:
+            for a in agents:
+                for ax in "xyz":
+                    e = float(r[f"{a}_p{ax}_est"]) - float(r[f"{a}_p{ax}_true"])
+                    sig = float(r[f"{a}_s{ax}"])
+                    s = acc.setdefault((r["phase"], a, ax), [0, 0.0, 0.0, 0.0])
+                    s[0] += 1
+                    s[1] += e
+                    s[2] += e * e
+                    s[3] += sig * sig
         for key, (n, se, se2, ss2) in acc.items():
             per.setdefault(key, []).append((se / n, se2 / n, ss2 / n))
     return per
 
 
-def motion_table(dirs, agents=("lead", "uav1")):
+def motion_table(runs, agents=("lead", "uav1")):
     """Per seed, phase and agent: the horizontal lag tau that best explains the position error as
     -tau v (least squares over x and y), the speed's relative error (the velocity error along the
     true velocity over |v|^2), and how much the x error changed from the phase's first step to its
     last. An estimate that trails the truth has tau > 0; a drift inside a phase shows in the change."""
     per = {}  # (phase, agent) -> [(tau, speed error, x change) per seed]
-    for d in dirs:
+    for rows in runs:
         acc, ends = {}, {}
-        with (d / "steps.csv").open() as f:
-            for r in csv.DictReader(f):
-                if r["k"] == "0":
-                    continue
-                for a in agents:
-                    s = acc.setdefault((r["phase"], a), [0.0, 0.0, 0.0])
-                    for ax in "xy":
-                        v = float(r[f"{a}_v{ax}_true"])
-                        s[0] += (float(r[f"{a}_p{ax}_est"]) - float(r[f"{a}_p{ax}_true"])) * v
-                        s[1] += (float(r[f"{a}_v{ax}_est"]) - v) * v
-                        s[2] += v * v
-                    ex = float(r[f"{a}_px_est"]) - float(r[f"{a}_px_true"])
-                    ends.setdefault((r["phase"], a), [ex, ex])[1] = ex
+        for r in rows:
+            for a in agents:
+                s = acc.setdefault((r["phase"], a), [0.0, 0.0, 0.0])
+                for ax in "xy":
+                    v = float(r[f"{a}_v{ax}_true"])
+                    s[0] += (float(r[f"{a}_p{ax}_est"]) - float(r[f"{a}_p{ax}_true"])) * v
+                    s[1] += (float(r[f"{a}_v{ax}_est"]) - v) * v
+                    s[2] += v * v
+                ex = float(r[f"{a}_px_est"]) - float(r[f"{a}_px_true"])
+                ends.setdefault((r["phase"], a), [ex, ex])[1] = ex
         for key, (ep, ev, vv) in acc.items():
             first, last = ends[key]
             per.setdefault(key, []).append((-ep / vv, ev / vv, last - first))
@@ -108,7 +108,8 @@ def main(argv):
         print(f"#### {variant}: signed error per phase over {len(dirs)} seeds (m; MSE m²)\n")
         print("| phase | agent | axis | mean signed error | sd over seeds | mean MSE | RMS error | filter σ |")
         print("|---|---|---|---|---|---|---|---|")
-        per = agent_table(dirs)
+        runs = [read_steps(d) for d in dirs]
+        per = agent_table(runs)
         for (phase, agent, axis), v in sorted(per.items()):
             means = [m for m, _, _ in v]
             sd = statistics.pstdev(means) if len(means) > 1 else float("nan")
@@ -119,7 +120,7 @@ def main(argv):
         print(f"\n#### {variant}: lag, speed and drift per phase, mean over seeds (range)\n")
         print("| phase | agent | lag τ (s) | speed error | x error change over the phase (m) |")
         print("|---|---|---|---|---|")
-        for (phase, agent), v in sorted(motion_table(dirs).items()):
+        for (phase, agent), v in sorted(motion_table(runs).items()):
             cells = []
             for i, fmt in enumerate(("{:+.2f}", "{:+.2%}", "{:+.3f}")):
                 col = [x[i] for x in v]
