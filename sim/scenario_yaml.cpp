@@ -371,10 +371,11 @@ Loc loc_of(const std::optional<Field>& f) { return f ? f->loc() : Loc{}; }
 
 void parse_noise(const Ctx& ctx, const Field& f, NoiseSpec& n) {
   MapView m(ctx, f,
-            {"pixel_sigma", "gps_sigma", "altimeter_sigma", "range_sigma", "ahrs_yaw_sigma",
+            {"pixel_sigma", "pixel_bias_sigma", "gps_sigma", "altimeter_sigma", "range_sigma", "ahrs_yaw_sigma",
              "outlier_fraction", "cooperative_outlier_fraction", "outlier_max_px",
              "gimbal_amplitude", "gimbal_omega", "gimbal_random_phase", "motion"});
   num(ctx, m, "pixel_sigma", n.pixel_sigma, ge(0));
+  num(ctx, m, "pixel_bias_sigma", n.pixel_bias_sigma, ge(0));
   num(ctx, m, "gps_sigma", n.gps_sigma, ge(0));
   num(ctx, m, "altimeter_sigma", n.altimeter_sigma, ge(0));
   num(ctx, m, "range_sigma", n.range_sigma, ge(0));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "sim/rng.hpp"
 
@@ -69,6 +70,21 @@ Eigen::Vector2d SyntheticSource::noisy(const Eigen::Vector2d& uv) {
   return {uv.x() + n(pixel_rng_), uv.y() + n(pixel_rng_)};
 }
 
+Eigen::Vector2d SyntheticSource::pixel_bias(int uav, std::size_t point) const {
+  if (scn_.noise.pixel_bias_sigma <= 0) return Eigen::Vector2d::Zero();
+  // Its own stream per camera and point, so the offset is the same whenever and however often
+  // the point is observed, and the white noise's stream is untouched.
+  auto rng = make_stream(scn_.seed ^ splitmix64(static_cast<std::uint64_t>(point)),
+                         "pixel_bias/" + std::to_string(uav));
+  std::normal_distribution<double> n(0.0, scn_.noise.pixel_bias_sigma);
+  const double bx = n(rng);
+  return {bx, n(rng)};
+}
+
+Eigen::Vector2d SyntheticSource::noisy(const Eigen::Vector2d& uv, int uav, std::size_t point) {
+  return noisy(uv) + pixel_bias(uav, point);
+}
+
 Eigen::Vector2d SyntheticSource::outlier(const Eigen::Vector2d& uv) {
   std::uniform_real_distribution<double> mag(0.0, scn_.noise.outlier_max_px), ang(0.0, 2 * M_PI);
   const double e = mag(outlier_rng_), a = ang(outlier_rng_);
@@ -89,7 +105,7 @@ std::vector<PixelObservation> SyntheticSource::observe_landmarks(
     o.point = *pt;
     o.true_uv = *uv;
     o.injected_outlier = is_outlier(outlier_rng_);
-    o.uv = o.injected_outlier ? outlier(*uv) : noisy(*uv);
+    o.uv = o.injected_outlier ? outlier(*uv) : noisy(*uv, uav, *pt);
     if (o.injected_outlier) ++injected_[uav];
     out.push_back(o);
   }
@@ -146,10 +162,10 @@ std::vector<PointPair> SyntheticSource::cross_matches(int uav_a, int uav_b, doub
   for (std::size_t i : spread(uav_a, t, std::move(both), count)) {
     PointPair p;
     p.point = i;
-    p.uv_a = noisy(*true_pixel(uav_a, t, field_[i]));
+    p.uv_a = noisy(*true_pixel(uav_a, t, field_[i]), uav_a, i);
     const Eigen::Vector2d true_b = *true_pixel(uav_b, t, field_[i]);
     p.injected_outlier = is_outlier(outlier_rng_);
-    p.uv_b = p.injected_outlier ? outlier(true_b) : noisy(true_b);
+    p.uv_b = p.injected_outlier ? outlier(true_b) : noisy(true_b, uav_b, i);
     if (p.injected_outlier) ++injected_.back();
     out.push_back(p);
   }
@@ -162,7 +178,7 @@ std::vector<PixelObservation> SyntheticSource::new_points(int uav, double t, int
     PixelObservation o;
     o.point = i;
     o.true_uv = *true_pixel(uav, t, field_[i]);
-    o.uv = noisy(o.true_uv);
+    o.uv = noisy(o.true_uv, uav, i);
     out.push_back(o);
   }
   return out;

@@ -58,6 +58,9 @@ class SyntheticSource {
   std::vector<PixelObservation> new_points(int uav, double t, int count);
 
   std::optional<Eigen::Vector2d> lead_pixel(int uav, double t);
+  // Camera uav's constant pixel offset for field point `point` (noise.pixel_bias_sigma; zero
+  // when that is 0): the same on every call.
+  Eigen::Vector2d pixel_bias(int uav, std::size_t point) const;
   Eigen::Vector3d gps(double t);
   double altimeter(int uav, double t);
   double range(int uav, double t);
@@ -66,7 +69,9 @@ class SyntheticSource {
   long injected_outliers(int uav) const { return injected_[uav]; }
 
  private:
-  Eigen::Vector2d noisy(const Eigen::Vector2d& uv);
+  Eigen::Vector2d noisy(const Eigen::Vector2d& uv);  // white pixel noise only (the lead)
+  // Landmark pixels: white noise plus the camera's constant offset for that point.
+  Eigen::Vector2d noisy(const Eigen::Vector2d& uv, int uav, std::size_t point);
   Eigen::Vector2d outlier(const Eigen::Vector2d& uv);
   std::vector<std::size_t> unmapped_in_view(int uav, double t) const;
   std::vector<std::size_t> spread(int uav, double t, std::vector<std::size_t> candidates, int count);

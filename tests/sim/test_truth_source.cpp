@@ -160,3 +160,44 @@ TEST(SyntheticSource, OutliersAreFivePercentWithinFifteenPixels) {
   EXPECT_NEAR(static_cast<double>(outliers) / total, scn.noise.outlier_fraction, 0.005);
   EXPECT_EQ(src.injected_outliers(0), outliers);
 }
+
+TEST(SyntheticSource, PixelBiasIsConstantPerCameraAndPointAndOffByDefault) {
+  Scenario scn = parse_scenarios("duration: 60\nseed: 4\nnoise: {pixel_sigma: 0.5, pixel_bias_sigma: 0.8, "
+                                 "outlier_fraction: 0, cooperative_outlier_fraction: 0}\n",
+                                 "inline.yaml").front();
+  EXPECT_DOUBLE_EQ(scn.noise.pixel_bias_sigma, 0.8);
+  const OpenLoopTruth truth(scn);
+  SyntheticSource src(scn, truth);
+  std::int64_t next_id = 0;
+  std::vector<std::int64_t> ids;
+  for (const auto& pp : src.cross_matches(0, 1, 0.0, 10000)) {
+    src.bind(next_id, pp.point);
+    ids.push_back(next_id++);
+  }
+  ASSERT_GT(ids.size(), 50u);
+  // Per point and camera: the mean error over 400 frames is the point's offset (white part
+  // averaged down to 0.5 / 20 px), the same whenever it is drawn, and differs between cameras.
+  std::vector<Eigen::Vector2d> mean0(ids.size(), Eigen::Vector2d::Zero()), mean1 = mean0;
+  constexpr int kFrames = 400;
+  for (int k = 0; k < kFrames; ++k) {
+    for (const auto& o : src.observe_landmarks(0, 0.0, ids)) mean0[o.landmark] += (o.uv - o.true_uv) / kFrames;
+    for (const auto& o : src.observe_landmarks(1, 0.0, ids)) mean1[o.landmark] += (o.uv - o.true_uv) / kFrames;
+  }
+  double ss0 = 0, ss_diff = 0;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const std::size_t p = *src.point_of(ids[i]);
+    EXPECT_LT((mean0[i] - src.pixel_bias(0, p)).norm(), 0.15) << "point " << p;
+    EXPECT_LT((mean1[i] - src.pixel_bias(1, p)).norm(), 0.15) << "point " << p;
+    ss0 += mean0[i].squaredNorm();
+    ss_diff += (mean0[i] - mean1[i]).squaredNorm();
+  }
+  const double n = static_cast<double>(ids.size());
+  EXPECT_NEAR(std::sqrt(ss0 / (2 * n)), 0.8, 0.2);              // per axis
+  EXPECT_NEAR(std::sqrt(ss_diff / (2 * n)), 0.8 * std::sqrt(2.0), 0.3);  // independent per camera
+
+  // Default 0: no offset, and the white noise draws exactly what it drew before.
+  const Scenario plain = paper_scenario();
+  EXPECT_DOUBLE_EQ(plain.noise.pixel_bias_sigma, 0.0);
+  SyntheticSource a(plain, truth);
+  EXPECT_EQ(a.pixel_bias(0, 7), Eigen::Vector2d::Zero());
+}
