@@ -53,6 +53,8 @@ slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
   s.cooperative.max_reprojection_px = e.max_reprojection_px;
   s.cooperative.min_depth_m = e.min_depth_m;
   s.cooperative.low_parallax_inverse_depth = e.low_parallax_inverse_depth;
+  s.cooperative.pixel_offset_sigma = e.pixel_offset_sigma;
+  s.inverse_depth.pixel_offset_sigma = e.pixel_offset_sigma;
   s.inverse_depth.rho = e.inverse_depth_rho;
   s.inverse_depth.sigma_rho = e.inverse_depth_sigma;
   s.linearity_threshold = e.linearity_threshold;

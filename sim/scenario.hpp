@@ -136,6 +136,9 @@ struct EstimatorSpec {
   double common_accel_state_sigma = 0, common_accel_state_time_constant = 0;
   // Measurement noise the filter assumes (R); may differ from the truth's.
   double pixel_sigma = 3.0;
+  // > 0: every cooperative landmark carries each other camera's constant pixel offset from the
+  // camera that initialised it, prior sigma this (px per axis); 0: pixel errors are white.
+  double pixel_offset_sigma = 0.0;
   double gps_sigma = 1.5;
   double altimeter_sigma = 0.5;
   double range_sigma = 0.5;

@@ -586,9 +586,10 @@ void parse_estimator(const Ctx& ctx, const Field& f, EstimatorSpec& e, Provenanc
     }
   }
   if (auto rf = m.get("measurement_noise")) {
-    MapView r(ctx, *rf, {"pixel_sigma", "gps_sigma", "altimeter_sigma", "range_sigma",
+    MapView r(ctx, *rf, {"pixel_sigma", "pixel_offset_sigma", "gps_sigma", "altimeter_sigma", "range_sigma",
                          "orientation_sigma", "orientation_time_constant"});
     num(ctx, r, "pixel_sigma", e.pixel_sigma, ge(0));
+    num(ctx, r, "pixel_offset_sigma", e.pixel_offset_sigma, ge(0));
     num(ctx, r, "gps_sigma", e.gps_sigma, ge(0));
     num(ctx, r, "altimeter_sigma", e.altimeter_sigma, ge(0));
     num(ctx, r, "range_sigma", e.range_sigma, ge(0));

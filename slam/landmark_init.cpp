@@ -127,7 +127,25 @@ InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& c
   const Eigen::Matrix3d pixel_cov = Jza * pixel_covariance(rig_a, pC_a, cfg.sigma_px) * Jza.transpose() +
                                     Jzb * pixel_covariance(rig_b, pC_b, cfg.sigma_px) * Jzb.transpose();
   const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
-  return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
+  if (!(cfg.pixel_offset_sigma > 0)) return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
+
+  // With pixel offsets: the point was triangulated from uv_b - o_b with o_b ~ N(0, sigma^2 I), so
+  // d point / d o_b = -Jzb; the other cameras' offsets start independent of everything.
+  const int extra = 2 * (s.num_cameras() - 1), d = 3 + extra;
+  const double var = cfg.pixel_offset_sigma * cfg.pixel_offset_sigma;
+  LandmarkSlot probe;  // where camera b's offset sits among the new parameters
+  probe.anchor_cam = cam_a;
+  probe.extra = extra;
+  const int ob = probe.pixel_offset(cam_b);  // probe.offset is 0: an index into value
+  Eigen::VectorXd value = Eigen::VectorXd::Zero(d);
+  value.head<3>() = t->point;
+  Eigen::MatrixXd cross_x = Eigen::MatrixXd::Zero(d, s.dim());
+  cross_x.topRows<3>() = cross;
+  Eigen::MatrixXd cov_x = var * Eigen::MatrixXd::Identity(d, d);
+  cov_x.topLeftCorner<3, 3>() = cov + var * Jzb * Jzb.transpose();
+  cov_x.block<3, 2>(0, ob) = -var * Jzb;
+  cov_x.block<2, 3>(ob, 0) = -var * Jzb.transpose();
+  return {s.add_landmark(LandmarkKind::Euclidean, value, cross_x, cov_x, cam_a), ""};
 }
 
 Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x_c,
@@ -165,7 +183,17 @@ InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& c
   Eigen::Matrix<double, 6, 6> pixel_cov = Juv * pixel_covariance(rig, ray_C, cfg.sigma_px) * Juv.transpose();
   pixel_cov(5, 5) = cfg.sigma_rho * cfg.sigma_rho;  // the depth prior, independent of the state
   const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
-  return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
+  if (!(cfg.pixel_offset_sigma > 0) || s.num_cameras() < 2)
+    return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
+  // The other cameras' offsets start at 0, independent of everything (this pixel has none).
+  const int d = 6 + 2 * (s.num_cameras() - 1);
+  Eigen::VectorXd value = Eigen::VectorXd::Zero(d);
+  value.head<6>() = y;
+  Eigen::MatrixXd cross_x = Eigen::MatrixXd::Zero(d, s.dim());
+  cross_x.topRows<6>() = cross;
+  Eigen::MatrixXd cov_x = cfg.pixel_offset_sigma * cfg.pixel_offset_sigma * Eigen::MatrixXd::Identity(d, d);
+  cov_x.topLeftCorner<6, 6>() = cov;
+  return {s.add_landmark(LandmarkKind::InverseDepth, value, cross_x, cov_x, cam), ""};
 }
 
 InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, const CameraRig& commanded_a,

@@ -43,6 +43,10 @@ struct CooperativeInitSettings {
   // Below min_parallax_deg: an inverse-depth landmark from the pair
   // (initialise_cooperative_inverse_depth) instead of a rejection.
   bool low_parallax_inverse_depth = false;
+  // > 0: the landmark carries each other camera's constant pixel offset from camera a's (prior
+  // N(0, sigma^2) per axis; LandmarkSlot::pixel_offset); camera b's pixel in the pair is taken
+  // with its offset, so the point's covariance grows by J_b sigma^2 J_b^T and is correlated with it.
+  double pixel_offset_sigma = 0.0;
 };
 
 // The rejection reason of a pair under min_parallax_deg.
@@ -65,6 +69,9 @@ struct InverseDepthInitSettings {
   double sigma_px = 3.0;
   double rho = 0.05;
   double sigma_rho = 0.04;
+  // > 0 with more than one camera: the landmark carries the other cameras' pixel offsets from
+  // this camera's, as CooperativeInitSettings::pixel_offset_sigma.
+  double pixel_offset_sigma = 0.0;
 };
 
 // Inverse-depth parameters of the ray through uv from a camera at x_c, with d y / d(x_c, uv)

@@ -148,6 +148,10 @@ std::optional<Measurement> landmark_measurement(const FilterState& s, const Land
                        cam.R_CW * (y(5) * (y.head<3>() - x_c) + inverse_depth_direction(y(3), y(4))));
   }
   m.blocks.push_back({FilterState::cam_pos(cam_index), J_xc});
+  if (const int o = lm.pixel_offset(cam_index); o >= 0) {  // uv = projection + this camera's offset
+    m.h += s.x.segment<2>(o);
+    m.blocks.push_back({o, Eigen::Matrix2d::Identity()});
+  }
   return m;
 }
 
@@ -210,8 +214,10 @@ std::optional<Eigen::Vector2d> predict_landmark_pixel(const FilterState& s, cons
                                                       const CameraRig& rig) {
   const CameraRig cam = estimated_rig(x, s.gimbal(cam_index), rig);
   const Eigen::Vector3d x_c = x.segment<3>(FilterState::cam_pos(cam_index));
-  if (lm.kind == LandmarkKind::Euclidean) return project_point(cam, x_c, x.segment<3>(lm.offset));
-  return project_inverse_depth(cam, x_c, x.segment<6>(lm.offset));
+  auto uv = lm.kind == LandmarkKind::Euclidean ? project_point(cam, x_c, x.segment<3>(lm.offset))
+                                                : project_inverse_depth(cam, x_c, x.segment<6>(lm.offset));
+  if (const int o = lm.pixel_offset(cam_index); uv && o >= 0) *uv += x.segment<2>(o);
+  return uv;
 }
 
 }  // namespace wingman::slam

@@ -22,10 +22,14 @@ const LandmarkSlot* FilterState::find(LandmarkId id) const {
 }
 
 LandmarkId FilterState::add_landmark(LandmarkKind kind, const Eigen::VectorXd& value,
-                                     const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov) {
+                                     const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov,
+                                     int anchor_cam) {
   const int n = dim();
   const int d = static_cast<int>(value.size());
-  if (d != (kind == LandmarkKind::Euclidean ? 3 : 6) || cross.rows() != d || cross.cols() != n ||
+  if (anchor_cam >= num_cameras_)
+    throw std::invalid_argument("FilterState::add_landmark: anchor camera out of range");
+  const int extra = anchor_cam >= 0 ? 2 * (num_cameras_ - 1) : 0;
+  if (d != (kind == LandmarkKind::Euclidean ? 3 : 6) + extra || cross.rows() != d || cross.cols() != n ||
       cov.rows() != d || cov.cols() != d)
     throw std::invalid_argument("FilterState::add_landmark: inconsistent sizes");
   x.conservativeResize(n + d);
@@ -38,6 +42,8 @@ LandmarkId FilterState::add_landmark(LandmarkKind kind, const Eigen::VectorXd& v
   slot.id = next_id_++;
   slot.kind = kind;
   slot.offset = n;
+  slot.anchor_cam = anchor_cam;
+  slot.extra = extra;
   landmarks_.push_back(slot);
   return slot.id;
 }

@@ -4,7 +4,7 @@
 // as white noise, and optionally one acceleration every agent shares (after the gimbal angles: the
 // formation's common manoeuvre as a Gauss-Markov process). Landmarks are Euclidean (3 parameters,
 // eq. 2) or inverse depth (6 parameters [x0 y0 z0 theta phi rho], Montiel et al. 2006) for the
-// single-UAV baseline.
+// single-UAV baseline, either optionally followed by the other cameras' constant pixel offsets.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,7 +22,21 @@ struct LandmarkSlot {
   LandmarkId id = -1;
   LandmarkKind kind = LandmarkKind::Euclidean;
   int offset = 0;  // index of its first parameter in x
-  int dim() const { return kind == LandmarkKind::Euclidean ? 3 : 6; }
+  // Optional pixel offsets after the point's parameters: two per camera other than the anchor
+  // (the camera that initialised it, whose own constant detector offset the point absorbs), so
+  // that a detector that puts the landmark's corner a little off in each camera, the same way in
+  // every frame, is not read as a disagreement between the cameras' poses (docs/results.md,
+  // "Pixel errors that persist along a track").
+  int anchor_cam = -1;
+  int extra = 0;
+  int base_dim() const { return kind == LandmarkKind::Euclidean ? 3 : 6; }
+  int dim() const { return base_dim() + extra; }
+  // Index in x of camera cam's two pixel offsets, or -1 (none: the anchor, or no offsets).
+  int pixel_offset(int cam) const {
+    if (extra == 0 || cam == anchor_cam || cam < 0) return -1;
+    const int k = cam < anchor_cam ? cam : cam - 1;
+    return 2 * k + 2 <= extra ? offset + base_dim() + 2 * k : -1;
+  }
 };
 
 class FilterState {
@@ -55,8 +69,9 @@ class FilterState {
 
   // Appends a landmark (state augmentation, eq. 52): `value` its parameters, `cross` its
   // covariance with the existing state (dim x n), `cov` its own covariance.
+  // With anchor_cam >= 0, value also holds 2 (num_cameras - 1) pixel offsets after the point.
   LandmarkId add_landmark(LandmarkKind kind, const Eigen::VectorXd& value,
-                          const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov);
+                          const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov, int anchor_cam = -1);
   // Deletes a landmark's rows and columns.
   void remove_landmark(LandmarkId id);
   // Replaces an inverse-depth landmark by its Euclidean form: value xyz and J = d xyz / d y.

@@ -792,5 +792,23 @@ TEST(ScenarioModel, SensorActiveTruthTable) {
   EXPECT_EQ(s.uav_index("lead"), -1);
 }
 
+
+TEST(ScenarioYaml, PixelBiasAndPixelOffsetSigmasParseAndMustBeNonNegative) {
+  const Scenario s = parse_scenarios("noise: {pixel_bias_sigma: 0.53}\n"
+                                     "estimator: {measurement_noise: {pixel_offset_sigma: 0.75}}\n",
+                                     "scn.yaml").front();
+  EXPECT_DOUBLE_EQ(s.noise.pixel_bias_sigma, 0.53);
+  EXPECT_DOUBLE_EQ(s.estimator.pixel_offset_sigma, 0.75);
+  const Scenario d = parse_scenarios("duration: 5\n", "scn.yaml").front();
+  EXPECT_DOUBLE_EQ(d.noise.pixel_bias_sigma, 0.0);
+  EXPECT_DOUBLE_EQ(d.estimator.pixel_offset_sigma, 0.0);
+  const std::string bad1 = "noise: {pixel_bias_sigma: -1}\n";
+  EXPECT_NE(error_of(bad1).find("pixel_bias_sigma"), std::string::npos) << error_of(bad1);
+  const std::string bad2 = "estimator:\n  measurement_noise: {pixel_offset_sigma: -0.1}\n";
+  const std::string e2 = error_of(bad2);
+  EXPECT_NE(e2.find("scn.yaml:2:"), std::string::npos) << e2;
+  EXPECT_NE(e2.find("pixel_offset_sigma"), std::string::npos) << e2;
+}
+
 }  // namespace
 }  // namespace wingman::sim

@@ -1,6 +1,8 @@
 // Every analytic Jacobian of slam/ against central differences.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include "../numdiff.hpp"
 #include "geometry/rotation.hpp"
 #include "slam/inverse_depth.hpp"
@@ -142,6 +144,11 @@ TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
   y << 1.6, -0.1, 16.9, 0.1, 0.05, 0.06;
   s.add_landmark(LandmarkKind::InverseDepth, y, Eigen::MatrixXd::Zero(6, s.dim()),
                  Eigen::Matrix<double, 6, 6>::Identity());
+  // A landmark anchored in camera 0 with camera 1's pixel offset after its point.
+  Eigen::VectorXd with_offset(5);
+  with_offset << -2, 1.5, 0.2, 0.7, -0.4;
+  s.add_landmark(LandmarkKind::Euclidean, with_offset, Eigen::MatrixXd::Zero(5, s.dim()),
+                 Eigen::MatrixXd::Identity(5, 5), 0);
 
   auto dense = [&](const Measurement& m) {
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m.dim(), s.dim());
@@ -152,6 +159,8 @@ TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
   const std::vector<Builder> builders = {
       [&](const FilterState& st) { return *landmark_measurement(st, st.landmarks()[0], 1, rig, {0, 0}, 3); },
       [&](const FilterState& st) { return *landmark_measurement(st, st.landmarks()[1], 0, rig, {0, 0}, 3); },
+      [&](const FilterState& st) { return *landmark_measurement(st, st.landmarks()[2], 1, rig, {0, 0}, 3); },
+      [&](const FilterState& st) { return *landmark_measurement(st, st.landmarks()[2], 0, rig, {0, 0}, 3); },
       [&](const FilterState& st) { return *lead_projection_measurement(st, 0, rig, {0, 0}, 3); },
       [&](const FilterState& st) { return gps_measurement(st, Eigen::Vector3d::Zero(), 1.5); },
       [&](const FilterState& st) { return altimeter_measurement(st, 1, rig, 0, 0.5); },
@@ -165,6 +174,11 @@ TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
       return builders[i](t).h;
     };
     EXPECT_LT((dense(m) - numerical_jacobian(h, s.x)).norm(), kTol) << "builder " << i;
+    if (i < 4) {  // the landmark builders predict what the frontend is told to search around
+      const auto& lm = s.landmarks()[i == 0 ? 0 : i == 1 ? 1 : 2];
+      const int cam = (i == 0 || i == 2) ? 1 : 0;
+      EXPECT_LT((*predict_landmark_pixel(s, s.x, lm, cam, rig) - m.h).norm(), 1e-9) << "builder " << i;
+    }
     // An estimated gimbal error is a state, not noise: nothing left to marginalise.
     if (GetParam()) {
       EXPECT_EQ(m.camera, -1) << "builder " << i;
@@ -222,3 +236,54 @@ TEST_P(BuilderTest, NewLandmarkCrossCovarianceIsItsStateJacobian) {
 }
 
 INSTANTIATE_TEST_SUITE_P(WithAndWithoutGimbalStates, BuilderTest, ::testing::Bool());
+
+// Cooperative initialisation with pixel offsets: camera b's pixel is taken with its offset o_b,
+// so the point and o_b start correlated by -sigma^2 d point / d uv_b, the point's covariance
+// grows by sigma^2 J J^T, and the offsets do not depend on the state.
+TEST_P(BuilderTest, CooperativeLandmarkWithPixelOffsetsCarriesTheirCovariance) {
+  const FilterState s = two_uav_state(GetParam());
+  const CameraRig rig = tilted_rig(true);
+  const Eigen::Vector3d X(3, -2, 0.4);
+  const Eigen::Vector2d uv_a = *project_point(estimated_rig(s.x, s.gimbal(0), rig),
+                                              s.x.segment<3>(FilterState::cam_pos(0)), X);
+  const Eigen::Vector2d uv_b = *project_point(estimated_rig(s.x, s.gimbal(1), rig),
+                                              s.x.segment<3>(FilterState::cam_pos(1)), X);
+  CooperativeInitSettings coop;
+  coop.min_parallax_deg = 0;
+  coop.max_reprojection_px = 1e9;
+  FilterState plain = s;
+  ASSERT_TRUE(initialise_cooperative(plain, 0, rig, uv_a, 1, rig, uv_b, coop).id);
+  coop.pixel_offset_sigma = 0.75;
+  FilterState t = s;
+  ASSERT_TRUE(initialise_cooperative(t, 0, rig, uv_a, 1, rig, uv_b, coop).id);
+  const LandmarkSlot& lm = t.landmarks().back();
+  ASSERT_EQ(lm.dim(), 5);
+  ASSERT_EQ(lm.anchor_cam, 0);
+  EXPECT_EQ(lm.pixel_offset(0), -1);
+  const int o = lm.pixel_offset(1);
+  ASSERT_EQ(o, lm.offset + 3);
+  EXPECT_LT((t.x.segment<3>(lm.offset) - plain.x.tail<3>()).norm(), 1e-12);
+  EXPECT_EQ(t.x.segment<2>(o), Eigen::Vector2d::Zero());
+
+  // d point / d uv_b by re-triangulating from shifted pixels.
+  auto point_from = [&](const Eigen::VectorXd& uv) -> Eigen::VectorXd {
+    FilterState u = s;
+    CooperativeInitSettings c = coop;
+    c.pixel_offset_sigma = 0;
+    EXPECT_TRUE(initialise_cooperative(u, 0, rig, uv_a, 1, rig, uv, c).id);
+    return u.x.tail<3>();
+  };
+  const Eigen::MatrixXd Jb = numerical_jacobian(point_from, Eigen::VectorXd(uv_b));
+  const double var = 0.75 * 0.75;
+  const int n = s.dim(), p = lm.offset;
+  EXPECT_LT((t.P.block(p, 0, 3, n) - plain.P.block(n, 0, 3, n)).norm(), 1e-9);  // cross with the state
+  EXPECT_LT(t.P.block(o, 0, 2, n).norm(), 1e-12);
+  EXPECT_LT((t.P.block<2, 2>(o, o) - var * Eigen::Matrix2d::Identity()).norm(), 1e-12);
+  EXPECT_LT((t.P.block(p, o, 3, 2) + var * Jb).norm(), 1e-4 * var * Jb.norm());
+  EXPECT_LT((t.P.block(p, p, 3, 3) - plain.P.block(n, n, 3, 3) - var * Jb * Jb.transpose()).norm(),
+            1e-4 * var * (Jb * Jb.transpose()).norm());
+  // Still a covariance.
+  const Eigen::MatrixXd Pn = t.P;
+  EXPECT_LT((Pn - Pn.transpose()).norm(), 1e-12);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Pn).eigenvalues().minCoeff(), 0.0);
+}
