@@ -93,6 +93,23 @@ std::pair<Eigen::MatrixXd, Eigen::MatrixXd> augmented_covariance(
   for (const auto& d : deps) cov.noalias() += cross.middleCols(d.col, d.J.cols()) * d.J.transpose();
   return {std::move(cross), std::move(cov)};
 }
+
+// A new landmark's parameters followed by the other cameras' pixel offsets (LandmarkSlot::
+// pixel_offset): zero, prior sigma^2 I, independent of the state and of the parameters.
+struct WithOffsets {
+  Eigen::VectorXd value;
+  Eigen::MatrixXd cross, cov;
+};
+WithOffsets append_pixel_offsets(const FilterState& s, const Eigen::VectorXd& value,
+                                 const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov, double sigma) {
+  const int b = static_cast<int>(value.size()), d = b + 2 * (s.num_cameras() - 1);
+  WithOffsets w{Eigen::VectorXd::Zero(d), Eigen::MatrixXd::Zero(d, s.dim()),
+                sigma * sigma * Eigen::MatrixXd::Identity(d, d)};
+  w.value.head(b) = value;
+  w.cross.topRows(b) = cross;
+  w.cov.topLeftCorner(b, b) = cov;
+  return w;
+}
 }  // namespace
 
 InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& commanded_a,
@@ -131,21 +148,16 @@ InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& c
 
   // With pixel offsets: the point was triangulated from uv_b - o_b with o_b ~ N(0, sigma^2 I), so
   // d point / d o_b = -Jzb; the other cameras' offsets start independent of everything.
-  const int extra = 2 * (s.num_cameras() - 1), d = 3 + extra;
   const double var = cfg.pixel_offset_sigma * cfg.pixel_offset_sigma;
+  auto w = append_pixel_offsets(s, t->point, cross, cov, cfg.pixel_offset_sigma);
   LandmarkSlot probe;  // where camera b's offset sits among the new parameters
   probe.anchor_cam = cam_a;
-  probe.extra = extra;
+  probe.extra = static_cast<int>(w.value.size()) - 3;
   const int ob = probe.pixel_offset(cam_b);  // probe.offset is 0: an index into value
-  Eigen::VectorXd value = Eigen::VectorXd::Zero(d);
-  value.head<3>() = t->point;
-  Eigen::MatrixXd cross_x = Eigen::MatrixXd::Zero(d, s.dim());
-  cross_x.topRows<3>() = cross;
-  Eigen::MatrixXd cov_x = var * Eigen::MatrixXd::Identity(d, d);
-  cov_x.topLeftCorner<3, 3>() = cov + var * Jzb * Jzb.transpose();
-  cov_x.block<3, 2>(0, ob) = -var * Jzb;
-  cov_x.block<2, 3>(ob, 0) = -var * Jzb.transpose();
-  return {s.add_landmark(LandmarkKind::Euclidean, value, cross_x, cov_x, cam_a), ""};
+  w.cov.topLeftCorner<3, 3>() += var * Jzb * Jzb.transpose();
+  w.cov.block<3, 2>(0, ob) = -var * Jzb;
+  w.cov.block<2, 3>(ob, 0) = -var * Jzb.transpose();
+  return {s.add_landmark(LandmarkKind::Euclidean, w.value, w.cross, w.cov, cam_a), ""};
 }
 
 Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x_c,
@@ -186,14 +198,8 @@ InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& c
   if (!(cfg.pixel_offset_sigma > 0) || s.num_cameras() < 2)
     return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
   // The other cameras' offsets start at 0, independent of everything (this pixel has none).
-  const int d = 6 + 2 * (s.num_cameras() - 1);
-  Eigen::VectorXd value = Eigen::VectorXd::Zero(d);
-  value.head<6>() = y;
-  Eigen::MatrixXd cross_x = Eigen::MatrixXd::Zero(d, s.dim());
-  cross_x.topRows<6>() = cross;
-  Eigen::MatrixXd cov_x = cfg.pixel_offset_sigma * cfg.pixel_offset_sigma * Eigen::MatrixXd::Identity(d, d);
-  cov_x.topLeftCorner<6, 6>() = cov;
-  return {s.add_landmark(LandmarkKind::InverseDepth, value, cross_x, cov_x, cam), ""};
+  const auto w = append_pixel_offsets(s, y, cross, cov, cfg.pixel_offset_sigma);
+  return {s.add_landmark(LandmarkKind::InverseDepth, w.value, w.cross, w.cov, cam), ""};
 }
 
 InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, const CameraRig& commanded_a,
