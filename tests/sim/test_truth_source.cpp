@@ -14,6 +14,17 @@ namespace {
 Scenario paper_scenario() {
   return parse_scenarios("duration: 60\nseed: 4\n", "inline.yaml").front();
 }
+
+// Binds every point that cameras 0 and 1 both see at t = 0 to a new landmark id; returns the ids.
+std::vector<std::int64_t> bind_all_seen_by_both(SyntheticSource& src) {
+  std::int64_t next_id = 0;
+  std::vector<std::int64_t> ids;
+  for (const auto& pp : src.cross_matches(0, 1, 0.0, 10000)) {
+    src.bind(next_id, pp.point);
+    ids.push_back(next_id++);
+  }
+  return ids;
+}
 }  // namespace
 
 TEST(Truth, LemniscateVelocityIsItsDerivative) {
@@ -140,12 +151,7 @@ TEST(SyntheticSource, OutliersAreFivePercentWithinFifteenPixels) {
   SyntheticSource src(scn, truth);
   // Bind every point in view and observe them over many frames.
   long total = 0, outliers = 0;
-  std::int64_t next_id = 0;
-  std::vector<std::int64_t> ids;
-  for (const auto& pp : src.cross_matches(0, 1, 0.0, 10000)) {
-    src.bind(next_id, pp.point);
-    ids.push_back(next_id++);
-  }
+  const std::vector<std::int64_t> ids = bind_all_seen_by_both(src);
   ASSERT_GT(ids.size(), 50u);
   for (int k = 0; k < 200; ++k) {
     for (const auto& o : src.observe_landmarks(0, 0.0, ids)) {
@@ -168,12 +174,7 @@ TEST(SyntheticSource, PixelBiasIsConstantPerCameraAndPointAndOffByDefault) {
   EXPECT_DOUBLE_EQ(scn.noise.pixel_bias_sigma, 0.8);
   const OpenLoopTruth truth(scn);
   SyntheticSource src(scn, truth);
-  std::int64_t next_id = 0;
-  std::vector<std::int64_t> ids;
-  for (const auto& pp : src.cross_matches(0, 1, 0.0, 10000)) {
-    src.bind(next_id, pp.point);
-    ids.push_back(next_id++);
-  }
+  const std::vector<std::int64_t> ids = bind_all_seen_by_both(src);
   ASSERT_GT(ids.size(), 50u);
   // Per point and camera: the mean error over 400 frames is the point's offset (white part
   // averaged down to 0.5 / 20 px), the same whenever it is drawn, and differs between cameras.

@@ -133,6 +133,21 @@ class BuilderTest : public ::testing::TestWithParam<bool> {
     s.P.setIdentity();
     return s;
   }
+  // Camera 0's and camera 1's pixels of X as the filter predicts them: rays that meet, as real
+  // matches nearly do. (Least-squares triangulation of rays that miss each other weighs them
+  // algebraically, and there a rotation and the equivalent pixel shift agree only to first order.)
+  static std::pair<Eigen::Vector2d, Eigen::Vector2d> predicted_pair(const FilterState& s, const CameraRig& rig,
+                                                                   const Eigen::Vector3d& X) {
+    return {*project_point(estimated_rig(s.x, s.gimbal(0), rig), s.x.segment<3>(FilterState::cam_pos(0)), X),
+            *project_point(estimated_rig(s.x, s.gimbal(1), rig), s.x.segment<3>(FilterState::cam_pos(1)), X)};
+  }
+  // Cooperative initialisation that accepts any pair, so the tests see the covariance of each.
+  static CooperativeInitSettings accept_any_pair() {
+    CooperativeInitSettings c;
+    c.min_parallax_deg = 0;
+    c.max_reprojection_px = 1e9;
+    return c;
+  }
 };
 
 TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
@@ -192,18 +207,9 @@ TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
 TEST_P(BuilderTest, NewLandmarkCrossCovarianceIsItsStateJacobian) {
   FilterState s = two_uav_state(GetParam());
   const CameraRig rig = tilted_rig(true);
-  // Pixels of one point as the filter predicts them: rays that meet, as real matches nearly do.
-  // (Least-squares triangulation of rays that miss each other weighs them algebraically, and
-  // there a rotation and the equivalent pixel shift agree only to first order.)
-  const Eigen::Vector3d X(3, -2, 0.4);
-  const Eigen::Vector2d uv_a = *project_point(estimated_rig(s.x, s.gimbal(0), rig),
-                                              s.x.segment<3>(FilterState::cam_pos(0)), X);
-  const Eigen::Vector2d uv_b = *project_point(estimated_rig(s.x, s.gimbal(1), rig),
-                                              s.x.segment<3>(FilterState::cam_pos(1)), X);
+  const auto [uv_a, uv_b] = predicted_pair(s, rig, Eigen::Vector3d(3, -2, 0.4));
   const Eigen::Vector2d uv_c(420.5, 610.1);
-  CooperativeInitSettings coop;
-  coop.min_parallax_deg = 0;
-  coop.max_reprojection_px = 1e9;
+  const CooperativeInitSettings coop = accept_any_pair();
   InverseDepthInitSettings idp;
 
   using Init = std::function<Eigen::VectorXd(FilterState&)>;
@@ -243,14 +249,8 @@ INSTANTIATE_TEST_SUITE_P(WithAndWithoutGimbalStates, BuilderTest, ::testing::Boo
 TEST_P(BuilderTest, CooperativeLandmarkWithPixelOffsetsCarriesTheirCovariance) {
   const FilterState s = two_uav_state(GetParam());
   const CameraRig rig = tilted_rig(true);
-  const Eigen::Vector3d X(3, -2, 0.4);
-  const Eigen::Vector2d uv_a = *project_point(estimated_rig(s.x, s.gimbal(0), rig),
-                                              s.x.segment<3>(FilterState::cam_pos(0)), X);
-  const Eigen::Vector2d uv_b = *project_point(estimated_rig(s.x, s.gimbal(1), rig),
-                                              s.x.segment<3>(FilterState::cam_pos(1)), X);
-  CooperativeInitSettings coop;
-  coop.min_parallax_deg = 0;
-  coop.max_reprojection_px = 1e9;
+  const auto [uv_a, uv_b] = predicted_pair(s, rig, Eigen::Vector3d(3, -2, 0.4));
+  CooperativeInitSettings coop = accept_any_pair();
   FilterState plain = s;
   ASSERT_TRUE(initialise_cooperative(plain, 0, rig, uv_a, 1, rig, uv_b, coop).id);
   coop.pixel_offset_sigma = 0.75;
