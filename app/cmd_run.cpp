@@ -35,6 +35,7 @@ struct RunOptions {
   std::string video;
   bool no_plots = false;
   bool no_prefetch = false;
+  bool correspondences = false;
   bool quiet = false;
 };
 
@@ -77,6 +78,9 @@ int run_command(const RunOptions& o) {
         throw UsageError("--video needs a scenario with measurements: rendered");
       RenderedOptions ro(gl, video);
       ro.prefetch = !o.no_prefetch;
+      if (o.correspondences && scn.measurements != sim::MeasurementMode::Rendered)
+        throw UsageError("--correspondences needs a scenario with measurements: rendered");
+      ro.correspondences = o.correspondences;
       rec = run_scenario(scn, ro,
                          [&](int k, int n) { progress.update(k, n, "steps"); });
     } catch (const std::invalid_argument& e) {
@@ -132,6 +136,11 @@ Subcommand add_run(CLI::App& parent) {
   cmd->add_flag("--no-prefetch", o->no_prefetch,
                 "Rendered, open loop: render each step's frames at that step, not during the "
                 "previous step's detection (same results, for timing comparisons)");
+  cmd->add_flag("--correspondences", o->correspondences,
+                "Rendered scenarios: also write correspondences.csv per variant, every tracked "
+                "correspondence offered to the filter with its true projection, label and whether "
+                "the filter accepted it (about 10 MB for the 210 s paper scene; "
+                "tools/track_error.py reads it)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return run_command(*o); }};
 }

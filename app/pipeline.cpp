@@ -174,6 +174,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     rec.frontend.detector = fe->detector_name();
     rec.frontend.renderer = fe->renderer_description();
     rec.frontend.oracle_pixels = scn.frontend.oracle_pixels;
+    rec.frontend.record_correspondences = ro.correspondences;
   }
 
   std::map<slam::LandmarkId, std::size_t> lm_record;  // filter id -> index in rec.landmarks
@@ -305,6 +306,11 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
       const bool outlier = fe ? labelled[i].outlier : obs_all[i].injected_outlier;
       if (!fe && outlier) ++oc.injected;
       if (outlier) ++oc.outliers;
+      if (fe && rec.frontend.record_correspondences) {
+        const LabelledCorrespondence& lc = labelled[i];
+        rec.frontend.correspondences.push_back(
+            {k, t, lc.c.cam, lc.c.id, lc.c.uv, lc.true_uv, lc.outlier, bool(vr.accepted[i])});
+      }
       if (vr.accepted[i]) {
         ++accepted;
         ++oc.accepted;

@@ -37,6 +37,8 @@ struct RenderedOptions {
   std::string video;  // non-empty: both cameras side by side with what the frontend did, per step
   // Open loop: render step k+1 while step k's detection runs (same results, less wall time).
   bool prefetch = true;
+  // Keep every tracked correspondence with its true projection (RunRecord::frontend).
+  bool correspondences = false;
 };
 eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& rendered = {},
                              const ProgressFn& progress = {}, const StateObserver& observer = {});

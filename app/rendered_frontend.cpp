@@ -297,6 +297,7 @@ std::vector<LabelledCorrespondence> RenderedFrontend::track(
                                                          c.frame.depth);
       lc.outlier = lr.label != vision::Label::Inlier;
       lc.error_px = lr.reprojection_px;
+      if (lr.true_uv) lc.true_uv = *lr.true_uv;
       if (scn_.frontend.oracle_pixels && !lc.outlier) {  // an inlier has a true projection
         lc.c.uv = *lr.true_uv;
         lc.error_px = 0;

@@ -49,6 +49,7 @@ struct LabelledCorrespondence {
   int keypoint = -1;
   bool outlier = false;  // > 3 px from the true projection, occluded, or no truth
   double error_px = std::numeric_limits<double>::quiet_NaN();  // to the true projection
+  Eigen::Vector2d true_uv = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 // A cross-UAV pixel pair for initialisation, with its label and what the store needs.

@@ -82,6 +82,20 @@ struct OutlierCounts {
   long outliers_accepted = 0;   // outliers among those
 };
 
+// One tracked correspondence offered to the filter (rendered mode, `wingman run
+// --correspondences`): where the frontend put the landmark and where it truly projects. Kept per
+// step and landmark so that errors can be followed along a track (tools/track_error.py).
+struct TrackedCorrespondence {
+  int k = 0;
+  double t = 0;
+  int cam = 0;
+  std::int64_t landmark = 0;
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  Eigen::Vector2d true_uv = Eigen::Vector2d::Constant(kNaN);  // NaN: the landmark has no truth
+  bool outlier = false;   // the ground-truth label (> 3 px, occluded or no truth)
+  bool accepted = false;  // by the filter's RANSAC and gate
+};
+
 // Rendered mode only: what the lead detector did against the truth, over every camera frame.
 struct FrontendRecord {
   bool enabled = false;
@@ -100,6 +114,9 @@ struct FrontendRecord {
   // Tracked correspondences the filter accepted: pixel to the landmark's true projection (NaN when
   // the landmark has no truth). Says whether the labelled outliers are near misses or mismatches.
   std::vector<double> accepted_error_px;
+  // Every tracked correspondence, when asked for (about 190 000 on the 210 s paper scene).
+  bool record_correspondences = false;
+  std::vector<TrackedCorrespondence> correspondences;
 };
 
 struct PhaseInfo {

@@ -269,6 +269,22 @@ void write_landmarks_csv(const RunRecord& run, const fs::path& path) {
   write_file(path, fmt::to_string(b));
 }
 
+void write_correspondences_csv(const RunRecord& run, const fs::path& path) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  fmt::format_to(out, "k,t,cam,landmark,u,v,true_u,true_v,outlier,accepted\n");
+  for (const TrackedCorrespondence& c : run.frontend.correspondences) {
+    fmt::format_to(out, "{},{:.9g},{},{},{:.6f},{:.6f},", c.k, c.t, c.cam, c.landmark, c.uv.x(),
+                   c.uv.y());
+    if (c.true_uv.allFinite())
+      fmt::format_to(out, "{:.6f},{:.6f}", c.true_uv.x(), c.true_uv.y());
+    else
+      fmt::format_to(out, ",");
+    fmt::format_to(out, ",{},{}\n", int(c.outlier), int(c.accepted));
+  }
+  write_file(path, fmt::to_string(b));
+}
+
 void write_map_ply(const RunRecord& run, const fs::path& path, MapPoints which) {
   std::vector<const LandmarkRecord*> kept;
   for (const LandmarkRecord& l : run.landmarks) {
@@ -305,6 +321,8 @@ void write_results(const Metrics& metrics, const RunRecord& run, const fs::path&
   write_map_ply(run, dir / "map.ply", MapPoints::estimate);
   write_map_ply(run, dir / "map_truth.ply", MapPoints::truth);
   write_formation_csv(run, dir / "formation.csv");
+  if (run.frontend.record_correspondences)
+    write_correspondences_csv(run, dir / "correspondences.csv");
 }
 
 std::string format_summary(const Metrics& m, const RunRecord& run) {

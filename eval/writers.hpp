@@ -26,6 +26,11 @@ void write_steps_csv(const RunRecord& run, const std::filesystem::path& path);
 // One row per initialised landmark: truth, estimates at init / phase end / end, origin.
 void write_landmarks_csv(const RunRecord& run, const std::filesystem::path& path);
 
+// One row per tracked correspondence offered to the filter (rendered mode, when recorded):
+// k, t, cam, landmark, u, v, true_u, true_v (empty when the landmark has no truth), outlier,
+// accepted. write_results writes it only when the run recorded them.
+void write_correspondences_csv(const RunRecord& run, const std::filesystem::path& path);
+
 // ASCII PLY of the landmarks still in the map at the end (t_removed NaN): their final
 // estimates coloured by origin (MapPoints::estimate), or their truth points (MapPoints::truth).
 enum class MapPoints { estimate, truth };

@@ -293,6 +293,22 @@ TEST_F(CliTest, HelpExitsZeroAndMentionsRun) {
   EXPECT_THAT(run.output, HasSubstr("--seed"));
 }
 
+// --video and --correspondences need rendered frames: refused on a synthetic scenario, before
+// anything is written.
+TEST_F(CliTest, RenderedOnlyOutputsAreRefusedOnSyntheticScenarios) {
+  for (const std::vector<std::string>& extra :
+       {std::vector<std::string>{"--correspondences"}, std::vector<std::string>{"--video", "v.avi"}}) {
+    const fs::path out = out_dir();
+    std::vector<std::string> args{"run", kSmoke.string(), "--out", out.string(), "--no-plots", "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = run_wingman(args, tmp_.path());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr(extra[0] + " needs a scenario with measurements: rendered"));
+    EXPECT_FALSE(fs::exists(out)) << extra[0];
+    EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty()) << extra[0];
+  }
+}
+
 TEST_F(CliTest, BadCommandLineExits2) {
   const RunResult none = run_wingman({}, tmp_.path());
   EXPECT_EQ(none.exit_code, 2) << none.output;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 
@@ -45,7 +46,9 @@ TEST(RenderedPipeline, SmokeRunMeetsIssueSixTargets) {
   const sim::Scenario scn = variant("multi");
   TempDir dir;
   const fs::path video = dir / "run.avi";
-  const eval::RunRecord rec = run_scenario(scn, RenderedOptions(render::GlBackend::Auto, video.string()));
+  RenderedOptions ro(render::GlBackend::Auto, video.string());
+  ro.correspondences = true;
+  const eval::RunRecord rec = run_scenario(scn, ro);
   const eval::Metrics m = eval::compute_metrics(rec);
 
   {
@@ -98,6 +101,38 @@ TEST(RenderedPipeline, SmokeRunMeetsIssueSixTargets) {
       worst = std::max(worst, (s.agents[0].p_est - s.agents[0].p_true).norm());
     EXPECT_LT(worst, 1.5);
     EXPECT_LT(m.table4.total[0].rms_error, 0.8);
+  }
+  {
+    SCOPED_TRACE("--correspondences: every tracked correspondence with its truth and fate");
+    long offered = 0, accepted = 0;
+    for (const auto& o : rec.outliers)
+      if (o.channel != "cooperative") offered += o.correspondences, accepted += o.accepted;
+    const auto& cs = rec.frontend.correspondences;
+    ASSERT_EQ(static_cast<long>(cs.size()), offered);
+    std::vector<double> accepted_errors;
+    long labelled_correct = 0;
+    for (const auto& c : cs) {
+      const double err = (c.uv - c.true_uv).norm();  // NaN without truth
+      if (c.accepted) accepted_errors.push_back(err);
+      if (c.outlier) continue;
+      ++labelled_correct;
+      EXPECT_LE(err, 3.0) << "step " << c.k << " camera " << c.cam << " landmark " << c.landmark;
+    }
+    EXPECT_GT(labelled_correct, offered * 9 / 10);
+    // The same errors, in the same order, as the accepted ones the metrics summarise.
+    ASSERT_EQ(static_cast<long>(accepted_errors.size()), accepted);
+    for (std::size_t i = 0; i < accepted_errors.size(); ++i) {
+      if (std::isnan(accepted_errors[i])) {
+        EXPECT_TRUE(std::isnan(rec.frontend.accepted_error_px[i])) << i;
+      } else {
+        EXPECT_NEAR(accepted_errors[i], rec.frontend.accepted_error_px[i], 1e-9) << i;
+      }
+    }
+    const fs::path out = dir / "results";
+    eval::write_results(m, rec, out);
+    const std::string csv = read_file(out / "correspondences.csv");
+    EXPECT_EQ(csv.rfind("k,t,cam,landmark,u,v,true_u,true_v,outlier,accepted\n", 0), 0u);
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), offered + 1);
   }
 }
 

@@ -200,6 +200,40 @@ TEST(Writers, LandmarksCsv) {
   EXPECT_EQ(split(lines[1], ',')[15], "nan");
 }
 
+TEST(Writers, CorrespondencesCsvOnlyWhenRecorded) {
+  test::TempDir tmp;
+  RunRecord run = test::make_record();
+  write_results(compute_metrics(run), run, tmp.path() / "off");
+  EXPECT_FALSE(fs::exists(tmp.path() / "off" / "correspondences.csv"));
+
+  run.frontend.record_correspondences = true;
+  TrackedCorrespondence a;
+  a.k = 3, a.t = 0.3, a.cam = 1, a.landmark = 42, a.uv = {10.25, 20.5}, a.true_uv = {10, 21};
+  a.accepted = true;
+  TrackedCorrespondence b;  // no truth: an outlier by definition, rejected
+  b.k = 4, b.t = 0.4, b.cam = 0, b.landmark = 7, b.uv = {1, 2}, b.outlier = true;
+  run.frontend.correspondences = {a, b};
+  write_results(compute_metrics(run), run, tmp.path() / "on");
+  const std::vector<std::string> lines = read_lines(tmp.path() / "on" / "correspondences.csv");
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], "k,t,cam,landmark,u,v,true_u,true_v,outlier,accepted");
+  const std::vector<std::string> r1 = split(lines[1], ',');
+  ASSERT_EQ(r1.size(), 10u);
+  EXPECT_EQ(r1[0], "3");
+  EXPECT_EQ(r1[2], "1");
+  EXPECT_EQ(r1[3], "42");
+  EXPECT_EQ(std::stod(r1[4]), 10.25);
+  EXPECT_EQ(std::stod(r1[7]), 21.0);
+  EXPECT_EQ(r1[8], "0");
+  EXPECT_EQ(r1[9], "1");
+  const std::vector<std::string> r2 = split(lines[2], ',');
+  ASSERT_EQ(r2.size(), 10u);
+  EXPECT_EQ(r2[6], "");
+  EXPECT_EQ(r2[7], "");
+  EXPECT_EQ(r2[8], "1");
+  EXPECT_EQ(r2[9], "0");
+}
+
 TEST(Writers, PlyVertexCountMatchesLandmarksStillInMap) {
   test::TempDir tmp;
   const RunRecord run = test::make_record();
