@@ -139,7 +139,7 @@ Subcommand add_run(CLI::App& parent) {
   cmd->add_flag("--correspondences", o->correspondences,
                 "Rendered scenarios: also write correspondences.csv per variant, every tracked "
                 "correspondence offered to the filter with its true projection, label and whether "
-                "the filter accepted it (about 10 MB for the 210 s paper scene; "
+                "the filter accepted it (about 5 MB for the 210 s paper scene; "
                 "tools/track_error.py reads it)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return run_command(*o); }};
