@@ -33,6 +33,7 @@ struct SlamOptions {
   std::string out;
   std::string variant;
   bool no_plots = false;
+  bool correspondences = false;
   bool quiet = false;
 };
 
@@ -54,7 +55,8 @@ int slam_command(const SlamOptions& o) {
   ProgressLine progress(fmt::format("[slam {}]", scn.name), o.quiet);
   eval::RunRecord rec;
   try {
-    rec = run_replay(scn, ds, [&](int k, int n) { progress.update(k, n, "steps"); });
+    rec = run_replay(scn, ds, [&](int k, int n) { progress.update(k, n, "steps"); }, std::nullopt,
+                     o.correspondences);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
@@ -81,6 +83,9 @@ Subcommand add_slam(CLI::App& parent) {
                   "Estimator settings of this variant of the dataset's scenario (default: the "
                   "variant it was rendered with, else the first)");
   cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
+  cmd->add_flag("--correspondences", o->correspondences,
+                "Also write correspondences.csv: every tracked correspondence offered to the "
+                "filter with its true projection, label and fate (as `wingman run`)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return slam_command(*o); }};
 }

@@ -591,7 +591,8 @@ eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progre
 
 eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
                            const ProgressFn& progress,
-                           const std::optional<vision::FeatureSettings>& features) {
+                           const std::optional<vision::FeatureSettings>& features,
+                           bool correspondences) {
   if (scn.closed_loop())
     throw std::invalid_argument(ds.root.string() +
                                 ": a dataset holds an open-loop flight; its scenario has a control: section");
@@ -653,7 +654,9 @@ eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds
     if (const auto* s = at(agent[u]->range, k)) return s->value;
     return std::nullopt;
   };
-  return run_loop(scn, truth, source, progress, {}, hooks, RenderedOptions{});
+  RenderedOptions ro;
+  ro.correspondences = correspondences;
+  return run_loop(scn, truth, source, progress, {}, hooks, ro);
 }
 
 eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& ro,

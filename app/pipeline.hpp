@@ -45,9 +45,11 @@ eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& re
 // Replays a dataset written by `wingman render` through the same frontend and estimator: its
 // frames, GPS/altimeter/range samples; its scenario (the dataset's scenario.yaml, the variant and
 // seed it was rendered with) gives the truth, checked against the dataset's camera poses.
+// `correspondences`: keep every tracked correspondence, as RenderedOptions::correspondences.
 eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
                            const ProgressFn& progress = {},
-                           const std::optional<vision::FeatureSettings>& features = std::nullopt);
+                           const std::optional<vision::FeatureSettings>& features = std::nullopt,
+                           bool correspondences = false);
 // run_scenario with the automatic GL backend (a synthetic scenario never makes a context).
 eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress = {},
                               const StateObserver& observer = {});

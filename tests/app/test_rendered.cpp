@@ -233,13 +233,21 @@ TEST(RenderedPipeline, SlamAndBenchFrontendReplayARenderedDataset) {
                         "--quiet", "--out", ds.string()},
                        dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = run_wingman({"slam", ds.string(), "--no-plots", "--quiet", "--out", (dir / "res").string()},
+  r = run_wingman({"slam", ds.string(), "--no-plots", "--quiet", "--correspondences", "--out",
+                   (dir / "res").string()},
                   dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string metrics = read_file(dir / "res" / "metrics.json");
   EXPECT_THAT(metrics, ::testing::HasSubstr("\"lead_detection_rate\": 1.0"));
   EXPECT_THAT(metrics, ::testing::HasSubstr("\"render\""));
   EXPECT_TRUE(fs::exists(dir / "res" / "landmarks.csv"));
+  {
+    // --correspondences on a replay: the header and the tracked correspondences of 10 steps (two
+    // cameras, about 20 landmarks each).
+    const std::string csv = read_file(dir / "res" / "correspondences.csv");
+    EXPECT_EQ(csv.rfind("k,t,cam,landmark,u,v,true_u,true_v,outlier,accepted\n", 0), 0u);
+    EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 10);
+  }
 
   // bench-frontend on the same dataset: one row per detector asked for.
   r = run_wingman({"bench-frontend", ds.string(), "--detector", "orb", "--detector", "gftt_orb",
