@@ -9,7 +9,7 @@ min and max; with two or more variants, also on how many seeds the first variant
 Table 4 total than each other one, per axis and on all six at once; and per seed, the share of
 outliers among the tracked correspondences each variant's filter accepted (Table 3, every
 channel but the cooperative one), the cooperative landmarks initialised and the outliers among
-them, the axes of Tables 4 and 5 above the paper's multi-UAV row (DESIGN.md §9), and the largest
+them, the axes of Tables 4 and 5 above the paper's multi-UAV row (docs/results.md), and the largest
 distance of a landmark's final estimate from its truth (landmarks.csv).
 """
 import csv
@@ -57,7 +57,7 @@ def paired_counts(first_runs, other_runs):
     return per_axis, sum(all(w) for w in wins), len(seeds)
 
 
-# DESIGN.md §9: the paper's Table 4 totals, multi-UAV (Xh, Yh, Zh, X1, Y1, Z1) and Table 5 final.
+# The paper's Table 4 totals, multi-UAV (Xh, Yh, Zh, X1, Y1, Z1) and Table 5 final.
 PAPER_MULTI_T4 = [0.1221, 0.1676, 0.0468, 0.7621, 0.4847, 0.0755]
 PAPER_MULTI_T5 = [0.4702, 0.4683, 1.2120]
 AXES = ["Xh", "Yh", "Zh", "X1", "Y1", "Z1"]
