@@ -41,15 +41,16 @@ int bench_command(const BenchOptions& o) {
     }
   }
   const Replay replay = load_replay(o.dataset, o.variant);
-  const sim::Scenario& scn = replay.scenario;
+  const RunConfig& scn = replay.scenario;
   // Each detector with the rest of the scenario's frontend section (bucketing, thresholds).
   std::vector<vision::FeatureSettings> settings;
   for (const auto& name : o.detectors) {
-    sim::FrontendSpec spec = scn.frontend;
-    spec.detector = name;
-    if (o.max_features > 0) spec.max_features = o.max_features;
+    vision::FeatureSettings f = scn.frontend.features;
+    if (o.max_features > 0) f.max_features = o.max_features;
     try {
-      settings.push_back(feature_settings(spec));
+      f.kind = vision::parse_detector(name);
+      f.validate();
+      settings.push_back(f);
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());
     }

@@ -100,7 +100,7 @@ pid_t spawn_worker(const MonteCarloOptions& o, std::uint64_t seed, const fs::pat
 }
 
 // Variant directories of one run: <run>/<variant> when the scenario has variants.
-std::vector<std::pair<std::string, std::string>> variant_labels(const std::vector<sim::Scenario>& scns) {
+std::vector<std::pair<std::string, std::string>> variant_labels(const std::vector<RunConfig>& scns) {
   std::vector<std::pair<std::string, std::string>> v;  // label, subdirectory ("" = the run itself)
   const bool nested = scns.size() > 1 || !scns.front().variant.empty();
   for (const auto& s : scns) v.emplace_back(nested ? s.variant : s.name, nested ? s.variant : "");
@@ -112,7 +112,7 @@ int montecarlo_command(const MonteCarloOptions& o) {
   if (o.batch != 0 && (o.batch < 2 || o.batch > o.runs))
     throw UsageError(fmt::format("--batch {}: a batch needs 2 to --runs ({}) runs", o.batch, o.runs));
   // Bad input fails here, before any work.
-  const auto scenarios = select_variants(sim::load_scenarios(o.scenario), o.variants, o.scenario);
+  const auto scenarios = select_variants(load_run_configs(o.scenario), o.variants, o.scenario);
   if (!o.no_plots && !eval::gnuplot_available())
     throw UsageError("gnuplot with the pngcairo terminal was not found; install it (setup.sh does) "
                      "or pass --no-plots");

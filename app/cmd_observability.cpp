@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/scenario.hpp"
+#include "app/run_config.hpp"
 #include "sim/synthetic_source.hpp"
 #include "sim/truth.hpp"
 #include "slam/observability.hpp"
@@ -152,7 +152,7 @@ slam::SensorSet preset(int config, int n2, int n1) {
 }
 
 // The sensors a scenario feeds at time t (its phase's configuration and each agent's kit).
-slam::SensorSet scenario_sensors(const sim::Scenario& scn, double t, int n1) {
+slam::SensorSet scenario_sensors(const RunConfig& scn, double t, int n1) {
   const int n2 = static_cast<int>(scn.uavs.size());
   slam::SensorSet s = slam::SensorSet::empty(n2, 0, false);
   for (int j = 0; j < n2; ++j) {
@@ -170,7 +170,7 @@ slam::SensorSet scenario_sensors(const sim::Scenario& scn, double t, int n1) {
 
 // The true state at t of a scenario's open-loop trajectory, with the n1 landmarks of its field
 // nearest (horizontally) to the UAVs that lie in front of every camera.
-slam::EvaluationPoint scenario_point(const sim::Scenario& scn, double t, int n1) {
+slam::EvaluationPoint scenario_point(const RunConfig& scn, double t, int n1) {
   const sim::OpenLoopTruth truth(scn);
   const int n2 = static_cast<int>(scn.uavs.size());
   std::vector<Eigen::Vector3d> cp, cv;
@@ -224,12 +224,12 @@ int observability_command(const ObsOptions& o) {
   std::string where;
   const int n1 = o.landmarks;
   if (!o.scenario.empty()) {
-    auto scenarios = sim::load_scenarios(o.scenario);
-    auto it = std::find_if(scenarios.begin(), scenarios.end(), [&](const sim::Scenario& s) {
+    auto scenarios = load_run_configs(o.scenario);
+    auto it = std::find_if(scenarios.begin(), scenarios.end(), [&](const RunConfig& s) {
       return o.variant.empty() || s.variant == o.variant;
     });
     if (it == scenarios.end()) throw UsageError(fmt::format("{}: no variant '{}'", o.scenario, o.variant));
-    const sim::Scenario& scn = *it;
+    const RunConfig& scn = *it;
     if (!(o.at >= 0 && o.at <= scn.duration))
       throw UsageError(fmt::format("--at: {} outside the scenario's [0, {}] s", o.at, scn.duration));
     if (o.uavs && *o.uavs != static_cast<int>(scn.uavs.size()))

@@ -70,15 +70,15 @@ struct RenderOptions {
   bool quiet = false;
 };
 
-sim::Scenario pick(const RenderOptions& o) {
-  sim::Scenario scn = select_variant(sim::load_scenarios(o.scenario), o.variant, o.scenario);
+RunConfig pick(const RenderOptions& o) {
+  RunConfig scn = select_variant(load_run_configs(o.scenario), o.variant, o.scenario);
   if (o.seed) scn.seed = *o.seed;
   return scn;
 }
 
 // Steps to render (after t = 0): the whole run, or what --frames / --duration keep. The world
 // is always built for the whole run, so a short preview shows exactly the full run's first frames.
-int steps_to_render(const RenderOptions& o, const sim::Scenario& scn) {
+int steps_to_render(const RenderOptions& o, const RunConfig& scn) {
   int n = scn.num_steps();
   if (o.frames && o.duration) throw UsageError("--frames and --duration exclude each other");
   if (o.frames) {
@@ -104,7 +104,7 @@ int render_command(const RenderOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  const sim::Scenario scn = pick(o);
+  const RunConfig scn = pick(o);
   const int n = steps_to_render(o, scn);
   InterruptGuard guard;  // from here on Ctrl-C is noticed at the next step and cleans up
   const fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);

@@ -37,6 +37,8 @@ struct RunOptions {
   bool no_prefetch = false;
   bool correspondences = false;
   bool quiet = false;
+  bool print_config = false;
+  std::optional<double> duration;
 };
 
 int run_command(const RunOptions& o) {
@@ -46,9 +48,15 @@ int run_command(const RunOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  auto scenarios = select_variants(sim::load_scenarios(o.scenario), o.variants, o.scenario);
-  if (o.seed)
-    for (auto& s : scenarios) s.seed = *o.seed;
+  auto scenarios = select_variants(load_run_configs(o.scenario), o.variants, o.scenario);
+  for (auto& s : scenarios) {
+    if (o.seed) s.seed = *o.seed;
+    if (o.duration) limit_duration(s, *o.duration);
+  }
+  if (o.print_config) {
+    for (const auto& s : scenarios) fmt::print("{}", config_yaml(s));
+    return 0;
+  }
   if (!o.no_plots && !eval::gnuplot_available())
     throw UsageError("gnuplot with the pngcairo terminal was not found; install it (setup.sh does) "
                      "or pass --no-plots");
@@ -92,6 +100,7 @@ int run_command(const RunOptions& o) {
     fs::create_directories(dir);
     const eval::Metrics metrics = eval::compute_metrics(rec);
     eval::write_results(metrics, rec, dir);
+    write_config(scn, dir / "config.yaml");
     if (!o.no_plots) eval::write_plots(rec, dir);
     if (!o.quiet) fmt::print("{}\n", eval::format_summary(metrics, rec));
     dirs.push_back(dir.string());
@@ -124,6 +133,12 @@ Subcommand add_run(CLI::App& parent) {
   cmd->add_option("scenario", o->scenario, "Scenario YAML file")->required();
   cmd->add_option("--out,-o", o->out, "Results directory (default: results/<scenario name>)");
   cmd->add_option("--seed", o->seed, "Override the scenario's seed");
+  cmd->add_option("--duration", o->duration,
+                  "Run only the first this many seconds (phases and outages cut there)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--print-config", o->print_config,
+                "Print each variant's resolved configuration (every key, defaults included) as "
+                "YAML and exit; every results directory keeps it as config.yaml");
   cmd->add_option("--variant", o->variants, "Run only these variants (repeatable)");
   cmd->add_option("--gl", o->gl,
                   "OpenGL backend for rendered scenarios: auto (EGL, then OSMesa), egl or osmesa")

@@ -40,7 +40,7 @@ struct SlamOptions {
 int slam_command(const SlamOptions& o) {
   const Replay replay = load_replay(o.dataset, o.variant);
   const datasets::Dataset& ds = replay.dataset;
-  const sim::Scenario& scn = replay.scenario;
+  const RunConfig& scn = replay.scenario;
   const fs::path& scn_path = replay.scenario_path;
   if (!o.no_plots && !eval::gnuplot_available())
     throw UsageError("gnuplot with the pngcairo terminal was not found; install it or pass --no-plots");

@@ -29,41 +29,6 @@ namespace wingman::app {
 namespace {
 
 
-slam::EstimatorSettings estimator_settings(const sim::Scenario& scn) {
-  const auto& e = scn.estimator;
-  slam::EstimatorSettings s;
-  s.accel_sigma_lead = e.accel_sigma_lead;
-  s.accel_sigma_uav = e.accel_sigma_uav;
-  s.accel_sigma_common = e.accel_sigma_common;
-  s.common_accel_state_sigma = e.common_accel_state_sigma;
-  s.common_accel_state_time_constant = e.common_accel_state_time_constant;
-  s.pixel_sigma = e.pixel_sigma;
-  s.gps_sigma = e.gps_sigma;
-  s.altimeter_sigma = e.altimeter_sigma;
-  s.range_sigma = e.range_sigma;
-  s.initial_position_sigma = e.initial_position_sigma;
-  s.initial_velocity_sigma = e.initial_velocity_sigma;
-  s.gimbal_time_constant = e.orientation_time_constant;
-  s.gate_probability = e.gate_probability;
-  s.visual.one_point_ransac = e.one_point_ransac;
-  s.visual.inlier_px = e.ransac_inlier_px;
-  s.visual.success_probability = e.ransac_success_probability;
-  s.visual.max_hypotheses = e.ransac_max_hypotheses;
-  s.cooperative.min_parallax_deg = e.min_parallax_deg;
-  s.cooperative.max_reprojection_px = e.max_reprojection_px;
-  s.cooperative.min_depth_m = e.min_depth_m;
-  s.cooperative.low_parallax_inverse_depth = e.low_parallax_inverse_depth;
-  s.cooperative.pixel_offset_sigma = e.pixel_offset_sigma;
-  s.inverse_depth.pixel_offset_sigma = e.pixel_offset_sigma;
-  s.inverse_depth.rho = e.inverse_depth_rho;
-  s.inverse_depth.sigma_rho = e.inverse_depth_sigma;
-  s.linearity_threshold = e.linearity_threshold;
-  s.max_landmarks = e.max_landmarks;
-  s.max_misses = e.max_misses;
-  s.image_margin_px = e.image_margin_px;
-  s.seed = scn.seed;
-  return s;
-}
 
 // NEES (eq. 67) over the agents' positions and velocities.
 double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
@@ -97,12 +62,12 @@ struct LoopHooks {
 
 // Synthetic mode: every measurement from `source`. Rendered mode: the visual ones from rendered
 // frames through the vision frontend, the others (GPS, altimeter, range) still from `source`.
-eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
+eval::RunRecord run_loop(const RunConfig& scn, const sim::Truth& truth,
                          sim::SyntheticSource& source, const ProgressFn& progress,
                          const StateObserver& observer, const LoopHooks& hooks,
                          const RenderedOptions& ro) {
   const auto wall0 = Clock::now();
-  const bool single = scn.estimator.mode == sim::EstimatorMode::SingleUav;
+  const bool single = scn.single_uav();
 
   // Cameras in the filter, by UAV index: every UAV (multi) or only the baseline's (single).
   std::vector<int> cam_uav;
@@ -136,9 +101,9 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   std::normal_distribution<double> unit(0.0, 1.0);
   auto initial_estimate = [&](const sim::KinematicState& k) {
     slam::AgentInit a{k.position, k.velocity};
-    if (!scn.estimator.draw_initial_error) return a;
-    a.position += sim::gaussian3(init_rng, unit, scn.estimator.initial_position_sigma);
-    a.velocity += sim::gaussian3(init_rng, unit, scn.estimator.initial_velocity_sigma);
+    if (!scn.estimator.initial_sigma.draw) return a;
+    a.position += sim::gaussian3(init_rng, unit, scn.estimator.initial_sigma.position);
+    a.velocity += sim::gaussian3(init_rng, unit, scn.estimator.initial_sigma.velocity);
     return a;
   };
   std::vector<slam::CameraRig> rigs;
@@ -148,18 +113,18 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
     rig.model = scn.uavs[u].camera.camera();
     rig.R_CW = truth.commanded_R_CW();
     rig.offset = scn.uavs[u].camera.offset;
-    rig.orientation_sigma = scn.estimator.orientation_sigma;
+    rig.orientation_sigma = scn.estimator.measurement_noise.orientation_sigma;
     rigs.push_back(rig);
     cam_init.push_back(initial_estimate(truth.camera(u, 0.0)));
   }
   const slam::AgentInit lead0 = initial_estimate(truth.lead(0.0));
-  slam::Estimator est(rigs, lead0, cam_init, estimator_settings(scn));
+  slam::Estimator est(rigs, lead0, cam_init, scn.estimator, scn.seed);
 
   eval::RunRecord rec;
   rec.scenario_path = scn.source_path;
   rec.scenario_name = scn.name;
   rec.variant = scn.variant;
-  rec.estimator_mode = sim::to_string(scn.estimator.mode);
+  rec.estimator_mode = slam::to_string(scn.estimator.mode);
   rec.seed = scn.seed;
   rec.software_version = kVersion;
   rec.agent_names.push_back("lead");
@@ -178,7 +143,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   }
 
   std::map<slam::LandmarkId, std::size_t> lm_record;  // filter id -> index in rec.landmarks
-  const int target = scn.estimator.target_landmarks_per_camera;
+  const int target = scn.estimator.map.target_per_camera;
 
   auto record_step = [&](int k, double t, int visible, int offered, int accepted, int initialised,
                          double tp, double tu, double ti, double tr = 0, double td = 0,
@@ -441,7 +406,7 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
         }
       }
       // The cameras cooperative matching left short fill up on their own, in inverse depth.
-      for (int j = 0; j < ncam && scn.estimator.monocular_fill; ++j) {
+      for (int j = 0; j < ncam && scn.estimator.initialisation.monocular_fill; ++j) {
         const int need = target - in_view[j] - added[j];
         if (!sees_landmarks[j] || need <= 0) continue;
         if (fe) {
@@ -475,24 +440,6 @@ eval::RunRecord run_loop(const sim::Scenario& scn, const sim::Truth& truth,
   return rec;
 }
 
-control::SlidingModeSettings controller_settings(const sim::ControlSpec& c) {
-  control::SlidingModeSettings s;
-  s.k1 = c.k1;
-  s.k2 = c.k2;
-  switch (c.switching) {
-    case sim::SwitchingSpec::Sign: s.switching = control::Switching::Sign; break;
-    case sim::SwitchingSpec::Saturation: s.switching = control::Switching::Saturation; break;
-    case sim::SwitchingSpec::Tanh: s.switching = control::Switching::Tanh; break;
-  }
-  s.boundary_width = c.boundary_width;
-  s.max_horizontal_speed = c.max_horizontal_speed;
-  s.max_vertical_speed = c.max_vertical_speed;
-  s.max_yaw_rate = c.max_yaw_rate;
-  s.max_acceleration = c.max_acceleration;
-  s.anti_windup = c.anti_windup;
-  s.lead_bearing_min_range = c.lead_bearing_min_range;
-  return s;
-}
 
 // Section 7.3: the estimator's positions and the AHRS yaw feed one sliding-mode controller per
 // UAV; its command, plus Delta_g (eq. 58), drives eq. 53 until the next step (ZOH, Fig. 7).
@@ -501,9 +448,9 @@ std::string fmt_missing(const datasets::Dataset& ds, const std::string& agent, i
          std::to_string(needed) + " steps to replay";
 }
 
-eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& progress,
+eval::RunRecord run_closed_loop(const RunConfig& scn, const ProgressFn& progress,
                                 const StateObserver& observer, const RenderedOptions& ro) {
-  if (scn.estimator.mode != sim::EstimatorMode::MultiUav)
+  if (scn.single_uav())
     throw std::invalid_argument("closed loop needs the multi-UAV estimator");
   sim::ClosedLoopTruth truth(scn);
   sim::SyntheticSource source(scn, truth);
@@ -518,7 +465,7 @@ eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& prog
                                  [&](const sim::UavControlSpec& c) { return c.uav == name; });
     if (it == scn.control.uavs.end()) throw std::invalid_argument("no control entry for " + name);
     ctrl.emplace_back(control::DesiredFormation{it->lambda_d, it->yaw_d},
-                      controller_settings(scn.control), scn.uavs[j].camera.offset);
+                      scn.controller, scn.uavs[j].camera.offset);
     pose.push_back({scn.uavs[j].initial_position, it->initial_yaw});
   }
   std::vector<control::BodyVelocity> cmd(n);
@@ -567,7 +514,7 @@ eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& prog
       const auto& d = ctrl[j].desired();
       if (d.yaw)
         f.lambda_d_true(3) = *d.yaw;
-      else if (lead.position.head<2>().norm() >= scn.control.lead_bearing_min_range)
+      else if (lead.position.head<2>().norm() >= scn.controller.lead_bearing_min_range)
         f.lambda_d_true(3) = control::FormationController::lead_bearing(lead.position, lead.velocity)(0);
       st.formation.push_back(f);
     }
@@ -580,7 +527,7 @@ eval::RunRecord run_closed_loop(const sim::Scenario& scn, const ProgressFn& prog
   return rec;
 }
 
-eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progress,
+eval::RunRecord run_open_loop(const RunConfig& scn, const ProgressFn& progress,
                               const StateObserver& observer, const RenderedOptions& ro) {
   const sim::OpenLoopTruth truth(scn);
   sim::SyntheticSource source(scn, truth);
@@ -589,7 +536,7 @@ eval::RunRecord run_open_loop(const sim::Scenario& scn, const ProgressFn& progre
 
 }  // namespace
 
-eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
+eval::RunRecord run_replay(const RunConfig& scn, const datasets::Dataset& ds,
                            const ProgressFn& progress,
                            const std::optional<vision::FeatureSettings>& features,
                            bool correspondences) {
@@ -620,7 +567,7 @@ eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds
   }
   // Filter camera index -> UAV index, as run_loop numbers them.
   std::vector<int> cam_uav;
-  if (scn.estimator.mode == sim::EstimatorMode::SingleUav)
+  if (scn.single_uav())
     cam_uav.push_back(scn.uav_index(scn.estimator.single_uav));
   else
     for (int u = 0; u < n; ++u) cam_uav.push_back(u);
@@ -659,13 +606,13 @@ eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds
   return run_loop(scn, truth, source, progress, {}, hooks, ro);
 }
 
-eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& ro,
+eval::RunRecord run_scenario(const RunConfig& scn, const RenderedOptions& ro,
                              const ProgressFn& progress, const StateObserver& observer) {
   return scn.closed_loop() ? run_closed_loop(scn, progress, observer, ro)
                            : run_open_loop(scn, progress, observer, ro);
 }
 
-eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress,
+eval::RunRecord run_synthetic(const RunConfig& scn, const ProgressFn& progress,
                               const StateObserver& observer) {
   return run_scenario(scn, RenderedOptions{}, progress, observer);
 }

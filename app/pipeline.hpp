@@ -10,7 +10,7 @@
 
 #include "eval/run_record.hpp"
 #include "render/gl_context.hpp"
-#include "sim/scenario.hpp"
+#include "app/run_config.hpp"
 #include "slam/state.hpp"
 #include "vision/features.hpp"
 
@@ -40,18 +40,18 @@ struct RenderedOptions {
   // Keep every tracked correspondence with its true projection (RunRecord::frontend).
   bool correspondences = false;
 };
-eval::RunRecord run_scenario(const sim::Scenario& scn, const RenderedOptions& rendered = {},
+eval::RunRecord run_scenario(const RunConfig& scn, const RenderedOptions& rendered = {},
                              const ProgressFn& progress = {}, const StateObserver& observer = {});
 // Replays a dataset written by `wingman render` through the same frontend and estimator: its
 // frames, GPS/altimeter/range samples; its scenario (the dataset's scenario.yaml, the variant and
 // seed it was rendered with) gives the truth, checked against the dataset's camera poses.
 // `correspondences`: keep every tracked correspondence, as RenderedOptions::correspondences.
-eval::RunRecord run_replay(const sim::Scenario& scn, const datasets::Dataset& ds,
+eval::RunRecord run_replay(const RunConfig& scn, const datasets::Dataset& ds,
                            const ProgressFn& progress = {},
                            const std::optional<vision::FeatureSettings>& features = std::nullopt,
                            bool correspondences = false);
 // run_scenario with the automatic GL backend (a synthetic scenario never makes a context).
-eval::RunRecord run_synthetic(const sim::Scenario& scn, const ProgressFn& progress = {},
+eval::RunRecord run_synthetic(const RunConfig& scn, const ProgressFn& progress = {},
                               const StateObserver& observer = {});
 
 }  // namespace wingman::app

@@ -18,7 +18,7 @@ namespace wingman::app {
 namespace {
 
 
-vision::LeadDetectorSettings lead_settings(const sim::Scenario& scn) {
+vision::LeadDetectorSettings lead_settings(const RunConfig& scn) {
   vision::LeadDetectorSettings s;
   switch (scn.world.lead.cue) {
     case sim::LeadModelSpec::Cue::Aruco:
@@ -40,7 +40,7 @@ vision::LeadDetectorSettings lead_settings(const sim::Scenario& scn) {
 // sized for the model's footprint at the camera's height (the model moves: features on it would
 // make landmarks that drift).
 vision::ExclusionBox predicted_lead_box(const Eigen::Vector2d& uv, double fx, double depth,
-                                        const sim::Scenario& scn) {
+                                        const RunConfig& scn) {
   const double half = std::max(20.0, 0.5 * 2.0 * scn.world.lead.height * fx / std::max(depth, 1.0));
   return {uv, half, half};
 }
@@ -53,54 +53,23 @@ std::string fmt_label(const std::string& name, double t) {
 
 }  // namespace
 
-vision::FeatureSettings feature_settings(const sim::FrontendSpec& spec) {
-  vision::FeatureSettings f;
-  f.kind = vision::parse_detector(spec.detector);
-  f.max_features = spec.max_features;
-  f.grid_cols = spec.grid_cols;
-  f.grid_rows = spec.grid_rows;
-  f.orb_fast_threshold = spec.orb_fast_threshold;
-  f.orb_levels = spec.orb_levels;
-  f.orb_scale_factor = static_cast<float>(spec.orb_scale_factor);
-  f.akaze_threshold = spec.akaze_threshold;
-  f.sift_contrast = spec.sift_contrast;
-  f.gftt_quality = spec.gftt_quality;
-  f.gftt_min_distance = spec.gftt_min_distance_px;
-  f.validate();
-  return f;
-}
-
-vision::TrackingSettings tracking_settings(const sim::FrontendSpec& spec) {
-  vision::TrackingSettings t;
-  t.gate_d2 = spec.tracking_gate_d2;
-  t.ratio = spec.tracking_ratio;
-  t.max_search_radius_px = spec.max_search_radius_px;
-  t.max_distance = spec.tracking_max_distance;
-  t.match_latest_descriptor = spec.tracking_match_latest;
-  t.validate();
-  return t;
-}
-
-vision::CrossMatchSettings cross_match_settings(const sim::FrontendSpec& spec,
-                                                const sim::EstimatorSpec& estimator) {
-  vision::CrossMatchSettings c;
-  c.ratio = spec.cross_ratio;
-  c.max_epipolar_px = spec.max_epipolar_px;
-  c.max_reprojection_px = spec.max_reprojection_px;
+vision::CrossMatchSettings cross_match_settings(const RunConfig& cfg) {
+  vision::CrossMatchSettings c = cfg.frontend.cross_matching;
   // Unless it turns them into inverse-depth landmarks, the estimator rejects pairs under its
   // minimum parallax; filtering them before the spread selection then lets it pick among pairs
   // that can be initialised (with a 3 m baseline, most of the image's outer cells are under 8
   // degrees and would be chosen, and rejected, every step).
-  c.min_parallax_deg = estimator.low_parallax_inverse_depth ? 0.0 : estimator.min_parallax_deg;
+  const auto& init = cfg.estimator.initialisation;
+  c.min_parallax_deg = init.low_parallax_inverse_depth ? 0.0 : init.min_parallax_deg;
   c.validate();
   return c;
 }
 
-RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav,
+RenderedFrontend::RenderedFrontend(const RunConfig& scn, std::vector<int> cam_uav,
                                    render::GlBackend backend)
     : scn_(scn),
       cam_uav_(std::move(cam_uav)),
-      features_(feature_settings(scn.frontend)),
+      features_(scn.frontend.features),
       lead_(lead_settings(scn)) {
   render::Scene scene;
   try {
@@ -116,21 +85,22 @@ RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> ca
         std::make_unique<render::ImageEffects>(scn.world.image, scn.seed, scn.uavs[u].name));
 }
 
-RenderedFrontend::RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav,
+RenderedFrontend::RenderedFrontend(const RunConfig& scn, std::vector<int> cam_uav,
                                    FrameSource frames,
                                    const std::optional<vision::FeatureSettings>& features)
     : scn_(scn),
       cam_uav_(std::move(cam_uav)),
       frames_(std::move(frames)),
-      features_(features ? *features : feature_settings(scn.frontend)),
+      features_(features ? *features : scn.frontend.features),
       lead_(lead_settings(scn)) {
   init_cameras();
 }
 
 void RenderedFrontend::init_cameras() {
   colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
-  tracking_ = tracking_settings(scn_.frontend);
-  cross_ = cross_match_settings(scn_.frontend, scn_.estimator);
+  tracking_ = scn_.frontend.tracking;
+  tracking_.validate();
+  cross_ = cross_match_settings(scn_);
   for (int u : cam_uav_) {
     Cam c;
     c.model = scn_.uavs[u].camera.camera();

@@ -18,6 +18,7 @@
 
 #include <opencv2/videoio.hpp>
 
+#include "app/run_config.hpp"
 #include "eval/run_record.hpp"
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
@@ -62,20 +63,17 @@ struct LabelledPair {
 // Frames of filter camera `cam` at step k from somewhere other than the renderer (a dataset).
 using FrameSource = std::function<render::Frame(int cam, int k)>;
 
-// The scenario's `frontend:` section as the vision frontend's settings (validated).
-vision::FeatureSettings feature_settings(const sim::FrontendSpec& spec);
-vision::TrackingSettings tracking_settings(const sim::FrontendSpec& spec);
-// The cross matcher's minimum parallax comes from the estimator's initialisation settings.
-vision::CrossMatchSettings cross_match_settings(const sim::FrontendSpec& spec,
-                                                const sim::EstimatorSpec& estimator);
+// The cross matcher's settings of a run: the frontend section's, with the minimum parallax of
+// the estimator's initialisation (validated).
+vision::CrossMatchSettings cross_match_settings(const RunConfig& cfg);
 
 class RenderedFrontend {
  public:
   // cam_uav: the UAV index of each filter camera (all UAVs, or the single-UAV baseline's one).
-  RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, render::GlBackend backend);
+  RenderedFrontend(const RunConfig& scn, std::vector<int> cam_uav, render::GlBackend backend);
   // Replay: frames from `frames` (already with their image effects), no GL context; features
   // as `features` says (bench-frontend compares detectors), else as the scenario says.
-  RenderedFrontend(const sim::Scenario& scn, std::vector<int> cam_uav, FrameSource frames,
+  RenderedFrontend(const RunConfig& scn, std::vector<int> cam_uav, FrameSource frames,
                    const std::optional<vision::FeatureSettings>& features = std::nullopt);
   ~RenderedFrontend();
   RenderedFrontend(const RenderedFrontend&) = delete;
@@ -140,7 +138,7 @@ class RenderedFrontend {
     std::optional<Eigen::Vector2d> lead;
     std::vector<Eigen::Vector2d> tracked, accepted, fresh;  // this step's, for the video
   };
-  const sim::Scenario& scn_;
+  const RunConfig& scn_;
   std::vector<int> cam_uav_;
   FrameSource frames_;
   std::unique_ptr<render::GlContext> ctx_;

@@ -19,10 +19,10 @@ Replay load_replay(const std::string& dir, const std::string& variant) {
   r.scenario_path = std::filesystem::path(dir) / "scenario.yaml";
   if (!std::filesystem::exists(r.scenario_path))
     throw UsageError(r.scenario_path.string() + ": missing (wingman render writes it)");
-  auto scenarios = sim::load_scenarios(r.scenario_path.string());
+  auto scenarios = load_run_configs(r.scenario_path.string());
   const std::string want = variant.empty() ? r.dataset.info.variant : variant;
   r.scenario = select_variant(std::move(scenarios), want, r.scenario_path.string());
-  sim::Scenario& scn = r.scenario;
+  RunConfig& scn = r.scenario;
   scn.seed = r.dataset.info.seed;
   scn.measurements = sim::MeasurementMode::Rendered;
   // A shortened dataset (render --frames/--duration) replays what it has.

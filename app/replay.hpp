@@ -7,13 +7,13 @@
 #include <string>
 
 #include "datasets/dataset.hpp"
-#include "sim/scenario.hpp"
+#include "app/run_config.hpp"
 
 namespace wingman::app {
 
 struct Replay {
   datasets::Dataset dataset;
-  sim::Scenario scenario;
+  RunConfig scenario;
   std::filesystem::path scenario_path;  // DIR/scenario.yaml
 };
 

@@ -8,14 +8,14 @@
 
 namespace wingman::app {
 
-std::vector<sim::Scenario> select_variants(std::vector<sim::Scenario> scenarios,
+std::vector<RunConfig> select_variants(std::vector<RunConfig> scenarios,
                                            const std::vector<std::string>& names,
                                            const std::string& path) {
   if (names.empty()) return scenarios;
-  std::vector<sim::Scenario> keep;
+  std::vector<RunConfig> keep;
   for (const auto& name : names) {
     auto it = std::find_if(scenarios.begin(), scenarios.end(),
-                           [&](const sim::Scenario& s) { return s.variant == name; });
+                           [&](const RunConfig& s) { return s.variant == name; });
     if (it == scenarios.end()) {
       std::string known;
       for (const auto& s : scenarios) known += (known.empty() ? "" : ", ") + s.variant;
@@ -27,7 +27,7 @@ std::vector<sim::Scenario> select_variants(std::vector<sim::Scenario> scenarios,
   return keep;
 }
 
-sim::Scenario select_variant(std::vector<sim::Scenario> scenarios, const std::string& name,
+RunConfig select_variant(std::vector<RunConfig> scenarios, const std::string& name,
                              const std::string& path) {
   if (name.empty()) return scenarios.front();
   return select_variants(std::move(scenarios), {name}, path).front();

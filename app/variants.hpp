@@ -5,17 +5,17 @@
 #include <string>
 #include <vector>
 
-#include "sim/scenario.hpp"
+#include "app/run_config.hpp"
 
 namespace wingman::app {
 
 // Keeps the named variants in the order given; all of them when `names` is empty. Throws
 // UsageError for an unknown name.
-std::vector<sim::Scenario> select_variants(std::vector<sim::Scenario> scenarios,
+std::vector<RunConfig> select_variants(std::vector<RunConfig> scenarios,
                                            const std::vector<std::string>& names,
                                            const std::string& path);
 // One variant by name, or the first one when `name` is empty.
-sim::Scenario select_variant(std::vector<sim::Scenario> scenarios, const std::string& name,
+RunConfig select_variant(std::vector<RunConfig> scenarios, const std::string& name,
                              const std::string& path);
 
 }  // namespace wingman::app

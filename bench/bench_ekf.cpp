@@ -81,12 +81,13 @@ Prepared prepare(int n_landmarks) {
   Prepared out;
   out.cam_truth = {Vector3d(-1.5, 0, 15), Vector3d(1.5, 0, 17)};
   slam::EstimatorSettings cfg;
-  cfg.accel_sigma_lead = 0.1;
-  cfg.accel_sigma_uav = 0.5;
-  cfg.max_landmarks = n_landmarks;
-  cfg.max_misses = 1 << 30;          // nothing is dropped for missing matches
-  cfg.cooperative.min_parallax_deg = 1.0;  // the far, out-of-view part of the grid
-  cfg.seed = 1;
+  cfg.process_noise = {0.1, 0.5, 0.0};  // white, per agent
+  cfg.measurement_noise.orientation_sigma = 0;
+  cfg.gating.ransac_inlier_px = 4;
+  cfg.map.max_landmarks = n_landmarks;
+  cfg.map.max_misses = 1 << 30;                 // nothing is dropped for missing matches
+  cfg.initialisation.min_parallax_deg = 1.0;  // the far, out-of-view part of the grid
+  cfg.initialisation.low_parallax_inverse_depth = false;
   const auto nadir_rig = nadir_rigs(2);
   auto rigs = nadir_rig;
   const std::vector<slam::AgentInit> cams = {{out.cam_truth[0], Vector3d::Zero()},

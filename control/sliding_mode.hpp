@@ -5,6 +5,8 @@
 // yaw), so it runs the same whether they come from synthetic measurements or rendered frames.
 #pragma once
 
+#include "geometry/settings.hpp"
+
 #include <Eigen/Core>
 #include <optional>
 
@@ -40,6 +42,24 @@ struct SlidingModeSettings {
   // psi_d = atan2(y_h, x_h) is undefined at the origin and jumps with the noise near it: closer
   // than this the last psi_d is held (the UAV's first yaw before any).
   double lead_bearing_min_range = 5.0;  // m
+
+  // The controller's keys of the scenario's control: section (sim owns the others).
+  template <class V>
+  void visit(V& v) {
+    v("k1", k1, geometry::ge(0));
+    v("k2", k2, geometry::gt(0));
+    v.choice("switching", switching,
+             {{"sign", Switching::Sign}, {"sat", Switching::Saturation}, {"tanh", Switching::Tanh}});
+    v("boundary_width", boundary_width, geometry::gt(0));
+    v.section("limits", [&](auto& l) {
+      l("horizontal_speed", max_horizontal_speed, geometry::gt(0));
+      l("vertical_speed", max_vertical_speed, geometry::gt(0));
+      l("yaw_rate", max_yaw_rate, geometry::gt(0));
+      l("acceleration", max_acceleration, geometry::ge(0));
+    });
+    v("anti_windup", anti_windup);
+    v("lead_bearing_min_range", lead_bearing_min_range, geometry::ge(0));
+  }
 };
 
 // lambda_d of one UAV: [lx, ly, lz] and either a fixed yaw or the lead's bearing from the world

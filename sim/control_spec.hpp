@@ -1,6 +1,7 @@
 // The `control:` section of a scenario (paper section 6 and 7.3): what the closed loop flies.
-// A scenario with this section runs in closed loop; sim never includes control/, so the
-// switching function is named here and app/ maps it onto the controller's.
+// A scenario with this section runs in closed loop. sim owns what the truth and the evaluation
+// need (initial yaws, the desired formation the truth is scored against, Delta_g, the settling
+// time); the controller's gains and limits are control::SlidingModeSettings, read by app/.
 #pragma once
 
 #include <Eigen/Core>
@@ -10,9 +11,6 @@
 #include <vector>
 
 namespace wingman::sim {
-
-enum class SwitchingSpec { Sign, Saturation, Tanh };
-const char* to_string(SwitchingSpec s);
 
 // One controlled UAV: its initial yaw and lambda_d (eq. 60); psi_d fixed or the lead's bearing
 // atan2(y_h, x_h) from its estimate (section 7.3).
@@ -25,14 +23,6 @@ struct UavControlSpec {
 
 struct ControlSpec {
   bool enabled = false;  // set by the presence of the section
-  Eigen::Vector4d k1 = Eigen::Vector4d::Constant(0.3);
-  Eigen::Vector4d k2{1.0, 1.0, 1.0, 0.5};
-  SwitchingSpec switching = SwitchingSpec::Saturation;
-  Eigen::Vector4d boundary_width{1.0, 1.0, 1.0, 0.3};
-  double max_horizontal_speed = 5.0, max_vertical_speed = 2.0, max_yaw_rate = 0.5;
-  double max_acceleration = 1.0;  // m/s^2, change of (vx, vy, vz) between commands; 0: none
-  bool anti_windup = true;
-  double lead_bearing_min_range = 5.0;
   // Delta_g of eq. 58, added to u = [-vx, -vy, vz, w] of every UAV: each component a sum of two
   // sinusoids with random frequencies and phases, |Delta_g_i| <= bound_i.
   Eigen::Vector4d disturbance_bound = Eigen::Vector4d::Zero();

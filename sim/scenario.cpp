@@ -81,16 +81,6 @@ std::vector<Sensor> sensors_of(Config c) {
   return {};
 }
 
-const char* to_string(EstimatorMode m) {
-  switch (m) {
-    case EstimatorMode::MultiUav:
-      return "multi";
-    case EstimatorMode::SingleUav:
-      return "single";
-  }
-  return "unknown";
-}
-
 const char* to_string(MeasurementMode m) {
   switch (m) {
     case MeasurementMode::Synthetic:
@@ -167,15 +157,6 @@ int Scenario::uav_index(const std::string& name) const {
 }  // namespace wingman::sim
 
 namespace wingman::sim {
-
-const char* to_string(SwitchingSpec s) {
-  switch (s) {
-    case SwitchingSpec::Sign: return "sign";
-    case SwitchingSpec::Saturation: return "sat";
-    case SwitchingSpec::Tanh: return "tanh";
-  }
-  return "?";
-}
 
 std::vector<UavControlSpec> paper_control_uavs() {
   UavControlSpec u1{"uav1", 1.0, {2.5, 1, 14}, std::nullopt};

@@ -4,17 +4,20 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "geometry/camera.hpp"
+#include "geometry/settings.hpp"
 #include "sim/control_spec.hpp"
-#include "sim/frontend_spec.hpp"
 #include "sim/world.hpp"
 
 namespace wingman::sim {
+
+struct SettingsLayer;  // sim/yaml_input.hpp
 
 // Measurement kinds a configuration switches on or off (Table 1).
 enum class Sensor { Landmarks, LeadProjection, Altimeter, Range, Gps };
@@ -26,9 +29,6 @@ enum class Config { C1, C2, C3, Integrated };
 const char* to_string(Config c);
 // The sensor set of a configuration preset.
 std::vector<Sensor> sensors_of(Config c);
-
-enum class EstimatorMode { MultiUav, SingleUav };
-const char* to_string(EstimatorMode m);
 
 // Synthetic: projections of a point field with the paper's noise; Rendered: rendered frames
 // through the vision frontend (app/).
@@ -43,12 +43,29 @@ struct LeadTrajectorySpec {
   double z_amplitude = 2.0;  // m
   double z_omega = 0.03;     // rad/s
   Eigen::Vector3d velocity{1.5, 0, 0};  // m/s, of the line
+
+  template <class V>
+  void visit(V& v) {
+    v.choice("type", type, {{"lemniscate", std::string("lemniscate")}, {"line", std::string("line")}});
+    v("scale", scale);
+    v("omega", omega);
+    v("z_amplitude", z_amplitude);
+    v("z_omega", z_omega);
+    v("velocity", velocity);
+  }
 };
 
 struct LeadSpec {
   Eigen::Vector3d initial_position{0, 0, 0};
   LeadTrajectorySpec trajectory{};
   bool gps = true;  // the lead carries the GPS (eq. 7)
+
+  template <class V>
+  void visit(V& v) {
+    v("initial_position", initial_position);
+    v("gps", gps);
+    v.section("trajectory", [&](auto& t) { trajectory.visit(t); });
+  }
 };
 
 struct CameraSpec {
@@ -56,18 +73,42 @@ struct CameraSpec {
   int width = 1000, height = 1000;
   geometry::Distortion distortion{};
   Eigen::Vector3d offset{0, 0, 0};  // d of eq. 59: camera position minus UAV position, world frame
+
+  template <class V>
+  void visit(V& v) {
+    v("fx", fx, geometry::gt(0));
+    v("fy", fy, geometry::gt(0));
+    v("cx", cx);
+    v("cy", cy);
+    v("width", width, geometry::in(1, 16384));
+    v("height", height, geometry::in(1, 16384));
+    v("distortion", distortion);  // k1 k2 p1 p2 [k3]
+    v("offset", offset);
+  }
   geometry::PinholeCamera camera() const {
     return geometry::PinholeCamera(fx, fy, cx, cy, width, height, distortion);
   }
 };
 
+// A UAV carries every sensor unless its entry switches one off, so that the configurations of
+// Table 1 have what they are defined by.
 struct UavSpec {
   std::string name;  // uav1, uav2, ...
   Eigen::Vector3d initial_position{0, 0, 15};
   CameraSpec camera{};
-  bool sees_lead = false;  // produces lead projections (eq. 5) when the configuration has them
-  bool altimeter = false;  // eq. 8
-  bool range = false;      // eq. 9, to the lead
+  bool sees_lead = true;  // produces lead projections (eq. 5) when the configuration has them
+  bool altimeter = true;  // eq. 8
+  bool range = true;      // eq. 9, to the lead
+
+  template <class V>
+  void visit(V& v) {
+    v("name", name);  // required; [a-z0-9_]+, unique, not "lead"
+    v("initial_position", initial_position);
+    v("sees_lead", sees_lead);
+    v("altimeter", altimeter);
+    v("range", range);
+    v.section("camera", [&](auto& c) { camera.visit(c); });
+  }
 };
 
 // Truth noise: what the simulated sensors add.
@@ -99,6 +140,27 @@ struct NoiseSpec {
     double accel_sigma_lead = 0, accel_sigma_uav = 0, accel_sigma_common = 0;  // m/s^2
     bool any() const { return accel_sigma_lead > 0 || accel_sigma_uav > 0 || accel_sigma_common > 0; }
   } motion;
+
+  template <class V>
+  void visit(V& v) {
+    v("pixel_sigma", pixel_sigma, geometry::ge(0));
+    v("pixel_bias_sigma", pixel_bias_sigma, geometry::ge(0));
+    v("gps_sigma", gps_sigma, geometry::ge(0));
+    v("altimeter_sigma", altimeter_sigma, geometry::ge(0));
+    v("range_sigma", range_sigma, geometry::ge(0));
+    v("ahrs_yaw_sigma", ahrs_yaw_sigma, geometry::ge(0));
+    v("outlier_fraction", outlier_fraction, geometry::in(0, 1));
+    v("cooperative_outlier_fraction", cooperative_outlier_fraction, geometry::in(0, 1));
+    v("outlier_max_px", outlier_max_px, geometry::ge(0));
+    v("gimbal_amplitude", gimbal_amplitude);
+    v("gimbal_omega", gimbal_omega);
+    v("gimbal_random_phase", gimbal_random_phase);
+    v.section("motion", [&](auto& m) {
+      m("accel_sigma_lead", motion.accel_sigma_lead, geometry::ge(0));
+      m("accel_sigma_uav", motion.accel_sigma_uav, geometry::ge(0));
+      m("accel_sigma_common", motion.accel_sigma_common, geometry::ge(0));
+    });
+  }
 };
 
 // Static 3D points scattered over the ground below the flight (synthetic mode).
@@ -107,6 +169,14 @@ struct LandmarkFieldSpec {
   double ground_height = 0.0;  // m, mean height of the ground
   double height_spread = 2.0;  // m, heights uniform in ground_height +- spread/2
   double margin = 60.0;        // m, beyond the flight's horizontal extent
+
+  template <class V>
+  void visit(V& v) {
+    v("density", density, geometry::gt(0));
+    v("ground_height", ground_height);
+    v("height_spread", height_spread, geometry::ge(0));
+    v("margin", margin, geometry::ge(0));
+  }
 };
 
 // A time window with a configuration; `add` and `remove` adjust its preset.
@@ -115,6 +185,8 @@ struct Phase {
   double t_start = 0, t_end = 0;
   Config config = Config::C1;
   std::vector<Sensor> add, remove;
+  std::string source;   // its key path in the file ("phases[1]"); empty for the default phase
+  int source_line = 0;  // 1-based line of its entry; 0 for the default phase
 };
 
 // A sensor switched off for a window; agent empty means every agent carrying it.
@@ -124,67 +196,6 @@ struct Outage {
   std::string agent;
 };
 
-struct EstimatorSpec {
-  EstimatorMode mode = EstimatorMode::MultiUav;
-  std::string single_uav = "uav1";  // whose camera the single-UAV baseline uses
-  // Process noise: white acceleration (eq. 34), m/s^2.
-  double accel_sigma_lead = 0.05;
-  double accel_sigma_uav = 0.05;
-  // An acceleration every agent shares (formation flight), on top of the two above.
-  double accel_sigma_common = 0;
-  // > 0 (both): the shared acceleration is a state, Gauss-Markov with this std and correlation time.
-  double common_accel_state_sigma = 0, common_accel_state_time_constant = 0;
-  // Measurement noise the filter assumes (R); may differ from the truth's.
-  double pixel_sigma = 3.0;
-  // > 0: every cooperative landmark carries each other camera's constant pixel offset from the
-  // camera that initialised it, prior sigma this (px per axis); 0: pixel errors are white.
-  double pixel_offset_sigma = 0.0;
-  double gps_sigma = 1.5;
-  double altimeter_sigma = 0.5;
-  double range_sigma = 0.5;
-  // Gimbal pointing noise about the camera's x and y axes that the filter assumes (rad); the
-  // truth's gimbal error is never given to it. 0 trusts R_CW exactly.
-  double orientation_sigma = 0.0;
-  // Correlation time (s) of that pointing error. > 0: the filter estimates each camera's error as
-  // a Gauss-Markov state; 0: it treats it as white noise, marginalised in every update.
-  double orientation_time_constant = 0.0;
-  // Initial uncertainty of the agents (the paper: known exactly).
-  double initial_position_sigma = 1e-3;
-  double initial_velocity_sigma = 1e-3;
-  // false: the filter starts at the truth exactly. true: at the truth plus a draw of those sigmas
-  // (seeded), so that the initial error is a sample of the initial covariance, as a Monte Carlo
-  // NEES test assumes; started exactly, the NEES sits below its bounds until the filter has
-  // forgotten its exact start (docs/results.md).
-  bool draw_initial_error = false;
-  // Robustness.
-  double gate_probability = 0.999;  // chi^2 gate on each innovation
-  bool one_point_ransac = true;
-  double ransac_inlier_px = 4.0;       // low-innovation inlier threshold (Civera et al. 2010)
-  double ransac_success_probability = 0.99;
-  int ransac_max_hypotheses = 100;
-  // Map.
-  int max_landmarks = 150;
-  int target_landmarks_per_camera = 25;
-  int max_misses = 5;  // consecutive predicted-visible frames without an accepted match
-  double image_margin_px = 10.0;
-  // Cooperative initialisation (eq. 47-52).
-  double min_parallax_deg = 3.0;
-  double max_reprojection_px = 10.0;
-  // A pair that triangulates nearer than this to either camera (m, along its optical axis) is
-  // rejected as a wrong match; 0 keeps every point in front of both cameras.
-  double min_depth_m = 0.0;
-  // A pair under min_parallax_deg becomes an inverse-depth landmark anchored at the first camera
-  // and corrected with the second pixel, instead of being rejected.
-  bool low_parallax_inverse_depth = false;
-  // Multi-UAV: a camera that cooperative matching leaves under target_per_camera initialises the
-  // rest from its own pixels in inverse depth, as the single-UAV baseline does. Not the paper's
-  // method (section 5.2 initialises cooperatively only), so off by default.
-  bool monocular_fill = false;
-  // Single-UAV inverse-depth initialisation (Montiel et al. 2006, Civera et al. 2008).
-  double inverse_depth_rho = 0.05;    // 1/m
-  double inverse_depth_sigma = 0.04;  // 1/m
-  double linearity_threshold = 0.1;
-};
 
 struct Scenario {
   std::string source_path;  // the YAML it came from
@@ -200,10 +211,12 @@ struct Scenario {
   LandmarkFieldSpec field{};
   std::vector<Phase> phases;
   std::vector<Outage> outages;
-  EstimatorSpec estimator{};
   ControlSpec control{};  // enabled: closed loop (section 6)
   WorldSpec world{};  // what `wingman render` draws (sim/world.hpp)
-  FrontendSpec frontend{};  // rendered measurements: the vision frontend's settings
+  // The YAML of the sections other modules define (estimator:, frontend:, the controller's keys
+  // of control:), the base's first and then the variant's, for app/ to read into those modules'
+  // own settings structs.
+  std::vector<std::shared_ptr<const SettingsLayer>> settings_layers;
 
   double dt() const { return 1.0 / rate; }
   int num_steps() const;  // steps after t = 0
@@ -221,7 +234,8 @@ class ScenarioError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Loads and validates a scenario. A file with `variants:` yields one Scenario per variant
+// Loads and validates the scenario's own sections (sim's: truth, sensors, noise, world); the
+// sections other modules define are kept in settings_layers, unread (app/run_config.hpp reads them). A file with `variants:` yields one Scenario per variant
 // (each the base with that variant's overrides); otherwise exactly one.
 std::vector<Scenario> load_scenarios(const std::string& path);
 // Same, from YAML text; `origin` stands for the file name in messages.

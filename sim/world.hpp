@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "geometry/settings.hpp"
+
 namespace wingman::sim {
 
 struct Scenario;
@@ -23,6 +25,18 @@ struct TerrainSpec {
   double resolution = 2;      // m between mesh vertices
   double road_half_width = 3;  // m of flat ground under a ground lead's path
   double road_blend = 8;       // m over which the terrain returns to its own relief
+
+  template <class V>
+  void visit(V& v) {
+    v("extent", extent, geometry::ge(0));
+    v("margin", margin, geometry::ge(0));
+    v("mean_height", mean_height);
+    v("relief", relief, geometry::ge(0));
+    v("relief_scale", relief_scale, geometry::gt(0));
+    v("resolution", resolution, geometry::in(0.1, 50));
+    v("road_half_width", road_half_width, geometry::ge(0));
+    v("road_blend", road_blend, geometry::gt(0));
+  }
 };
 
 struct TextureSpec {
@@ -43,6 +57,20 @@ struct TextureSpec {
   // the nearest one only (GL_LINEAR_MIPMAP_NEAREST), a quarter less rendering time on llvmpipe,
   // with a visible step in sharpness where the level changes (docs/rendering.md, Speed).
   Filter filter = Filter::Trilinear;
+
+  template <class V>
+  void visit(V& v) {
+    v.choice("type", type, {{"image", Type::Image}, {"procedural", Type::Procedural}});
+    v("image", image);
+    v.choice("mode", mode, {{"tiled", Mode::Tiled}, {"stretched", Mode::Stretched}});
+    v("tile_size", tile_size, geometry::gt(0));
+    v("detail_min", detail_min, geometry::gt(0));
+    v("detail_max", detail_max, geometry::gt(0));
+    v.check("detail_max", detail_max >= detail_min, "must be at least detail_min");
+    v("size", size, geometry::in(16, 8192));
+    v("anisotropy", anisotropy, geometry::in(1, 64));
+    v.choice("filter", filter, {{"trilinear", Filter::Trilinear}, {"bilinear", Filter::Bilinear}});
+  }
 };
 
 struct ObjectsSpec {
@@ -50,6 +78,14 @@ struct ObjectsSpec {
   double trees = 12;
   double buildings = 2;
   double clearance = 8;   // m kept free on both sides of the lead's path
+
+  template <class V>
+  void visit(V& v) {
+    v("boulders", boulders, geometry::in(0, 1000));
+    v("trees", trees, geometry::in(0, 1000));
+    v("buildings", buildings, geometry::in(0, 1000));
+    v("clearance", clearance, geometry::ge(0));
+  }
 };
 
 struct LeadModelSpec {
@@ -64,12 +100,33 @@ struct LeadModelSpec {
   int aruco_id = 0;                 // from DICT_4X4_50
   double marker_size = 2.0;         // m, the black square of the marker (or the panel's side)
   Eigen::Vector3d panel_colour{1.0, 0.0, 1.0};  // cue: panel
+
+  template <class V>
+  void visit(V& v) {
+    v("model", model);
+    v.choice("kind", kind, {{"ground", Kind::Ground}, {"aerial", Kind::Aerial}});
+    v("height", height, geometry::gt(0));
+    v.choice("up", up, {{"y", std::string("y")}, {"z", std::string("z")}});
+    v("yaw_offset", yaw_offset);
+    v.choice("cue", cue, {{"aruco", Cue::Aruco}, {"panel", Cue::Panel}, {"none", Cue::None}});
+    v("aruco_id", aruco_id, geometry::in(0, 49));
+    v("marker_size", marker_size, geometry::gt(0));
+    v("panel_colour", panel_colour, geometry::in(0, 1));  // RGB
+  }
 };
 
 struct LightSpec {
   Eigen::Vector3d direction{-0.4, 0.3, -1.0};  // world frame, the way the light travels
   double ambient = 0.45;
   double diffuse = 0.65;
+
+  template <class V>
+  void visit(V& v) {
+    v("direction", direction);
+    v.check("direction", direction.norm() >= 1e-9, "must not be the zero vector");
+    v("ambient", ambient, geometry::in(0, 2));
+    v("diffuse", diffuse, geometry::in(0, 2));
+  }
 };
 
 struct ImageEffectsSpec {
@@ -79,6 +136,17 @@ struct ImageEffectsSpec {
   double exposure_gain = 1;       // multiplies the image
   double exposure_variation = 0;  // relative, per frame: gain * (1 + N(0, variation))
   Eigen::Vector3d sky{0.62, 0.74, 0.88};  // colour where no surface is hit
+
+  template <class V>
+  void visit(V& v) {
+    v("msaa", msaa, geometry::in(1, 16));
+    v.check("msaa", (msaa & (msaa - 1)) == 0, "must be 1, 2, 4, 8 or 16");
+    v("noise_sigma", noise_sigma, geometry::ge(0));
+    v("blur_sigma", blur_sigma, geometry::ge(0));
+    v("exposure_gain", exposure_gain, geometry::gt(0));
+    v("exposure_variation", exposure_variation, geometry::in(0, 1));
+    v("sky", sky, geometry::in(0, 1));  // RGB
+  }
 };
 
 struct WorldSpec {
@@ -89,6 +157,19 @@ struct WorldSpec {
   LightSpec light{};
   ImageEffectsSpec image{};
   double near = 0.1, far = 1000;  // m, clip planes
+
+  template <class V>
+  void visit(V& v) {
+    v.section("terrain", [&](auto& x) { terrain.visit(x); });
+    v.section("texture", [&](auto& x) { texture.visit(x); });
+    v.section("objects", [&](auto& x) { objects.visit(x); });
+    v.section("lead", [&](auto& x) { lead.visit(x); });
+    v.section("light", [&](auto& x) { light.visit(x); });
+    v.section("image", [&](auto& x) { image.visit(x); });
+    v("near", near, geometry::gt(0));
+    v("far", far, geometry::gt(0));
+    v.check("far", far > near, "must exceed near");
+  }
 };
 
 // Terrain heights: seeded smooth relief around the mean height; with a ground lead, a flat road

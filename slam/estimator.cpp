@@ -9,19 +9,20 @@
 namespace wingman::slam {
 
 Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
-                     const std::vector<AgentInit>& camera_init, const EstimatorSettings& settings)
+                     const std::vector<AgentInit>& camera_init, const EstimatorSettings& settings,
+                     std::uint64_t seed)
     : cams_(std::move(cameras)),
       cfg_(settings),
       s_(static_cast<int>(cams_.size()),
-         settings.gimbal_time_constant > 0 &&
+         settings.measurement_noise.orientation_time_constant > 0 &&
              std::any_of(cams_.begin(), cams_.end(),
                          [](const CameraRig& c) { return c.orientation_sigma > 0; }),
-         settings.common_accel_state_sigma > 0 && settings.common_accel_state_time_constant > 0),
-      rng_(settings.seed) {
+         settings.process_noise.common_acceleration_state()),
+      rng_(seed) {
   if (camera_init.size() != cams_.size())
     throw std::invalid_argument("Estimator: one initial state per camera");
-  const double sp2 = cfg_.initial_position_sigma * cfg_.initial_position_sigma;
-  const double sv2 = cfg_.initial_velocity_sigma * cfg_.initial_velocity_sigma;
+  const double sp2 = cfg_.initial_sigma.position * cfg_.initial_sigma.position;
+  const double sv2 = cfg_.initial_sigma.velocity * cfg_.initial_sigma.velocity;
   auto set = [&](int pos, const AgentInit& a) {
     s_.x.segment<3>(pos) = a.position;
     s_.x.segment<3>(pos + 3) = a.velocity;
@@ -34,18 +35,16 @@ Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
     if (const int g = s_.gimbal(j); g >= 0)
       s_.P.block<2, 2>(g, g).diagonal().setConstant(cams_[j].orientation_sigma * cams_[j].orientation_sigma);
   if (const int a = s_.common_acceleration(); a >= 0)
-    s_.P.block<3, 3>(a, a).diagonal().setConstant(cfg_.common_accel_state_sigma * cfg_.common_accel_state_sigma);
-  cfg_.visual.sigma_px = cfg_.pixel_sigma;
-  cfg_.visual.gate_probability = cfg_.gate_probability;
-  cfg_.cooperative.sigma_px = cfg_.pixel_sigma;
-  cfg_.inverse_depth.sigma_px = cfg_.pixel_sigma;
+    s_.P.block<3, 3>(a, a).diagonal().setConstant(cfg_.process_noise.common_state_sigma *
+                                                  cfg_.process_noise.common_state_sigma);
 }
 
 void Estimator::predict(double dt) {
-  predict_constant_velocity(s_, dt, cfg_.accel_sigma_lead, cfg_.accel_sigma_uav, cfg_.accel_sigma_common);
+  const ProcessNoiseSettings& q = cfg_.process_noise;
+  predict_constant_velocity(s_, dt, q.accel_sigma_lead, q.accel_sigma_uav, q.accel_sigma_common);
   for (int j = 0; j < num_cameras(); ++j)
-    predict_gimbal_error(s_, j, dt, cams_[j].orientation_sigma, cfg_.gimbal_time_constant);
-  predict_common_acceleration(s_, dt, cfg_.common_accel_state_sigma, cfg_.common_accel_state_time_constant);
+    predict_gimbal_error(s_, j, dt, cams_[j].orientation_sigma, cfg_.measurement_noise.orientation_time_constant);
+  predict_common_acceleration(s_, dt, q.common_state_sigma, q.common_state_time_constant);
 }
 
 std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
@@ -53,8 +52,8 @@ std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
   const CameraRig& rig = cams_[cam];
   for (const auto& lm : s_.landmarks()) {
     auto uv = predict_landmark_pixel(s_, s_.x, lm, cam, rig);
-    if (!uv || !rig.model.in_image(*uv, cfg_.image_margin_px)) continue;
-    auto m = landmark_measurement(s_, lm, cam, rig, *uv, cfg_.pixel_sigma);
+    if (!uv || !rig.model.in_image(*uv, cfg_.map.image_margin_px)) continue;
+    auto m = landmark_measurement(s_, lm, cam, rig, *uv, cfg_.measurement_noise.pixel_sigma);
     if (!m) continue;
     out.push_back({lm.id, *uv, innovation_covariance(s_, *m)});
     tracks_[lm.id].expected = true;
@@ -67,9 +66,10 @@ VisualUpdateResult Estimator::update_visual(
     const std::vector<std::pair<int, Eigen::Vector2d>>& lead_pixels) {
   std::vector<Measurement> lead;
   for (const auto& [cam, uv] : lead_pixels)
-    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.pixel_sigma))
+    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.measurement_noise.pixel_sigma))
       lead.push_back(std::move(*m));
-  VisualUpdateResult r = update_with_correspondences(s_, cams_, candidates, cfg_.visual, rng_, lead);
+  VisualUpdateResult r = update_with_correspondences(s_, cams_, candidates, cfg_.gating,
+                                                     cfg_.measurement_noise.pixel_sigma, rng_, lead);
   for (size_t i = 0; i < candidates.size(); ++i)
     if (r.accepted[i]) tracks_[candidates[i].id].matched = true;
   return r;
@@ -77,21 +77,21 @@ VisualUpdateResult Estimator::update_visual(
 
 SensorUpdateResult Estimator::update_sensors(const SensorBatch& b) {
   std::vector<Measurement> ms;
-  if (b.gps) ms.push_back(gps_measurement(s_, *b.gps, cfg_.gps_sigma));
+  if (b.gps) ms.push_back(gps_measurement(s_, *b.gps, cfg_.measurement_noise.gps_sigma));
   for (const auto& [cam, z] : b.altimeter)
-    ms.push_back(altimeter_measurement(s_, cam, cams_[cam], z, cfg_.altimeter_sigma));
+    ms.push_back(altimeter_measurement(s_, cam, cams_[cam], z, cfg_.measurement_noise.altimeter_sigma));
   for (const auto& [cam, z] : b.range)
-    ms.push_back(range_measurement(s_, cam, cams_[cam], z, cfg_.range_sigma));
+    ms.push_back(range_measurement(s_, cam, cams_[cam], z, cfg_.measurement_noise.range_sigma));
   SensorUpdateResult r;
   r.offered = static_cast<int>(ms.size());
   if (ms.empty()) return r;
-  const auto ok = update_with_gated_measurements(s_, ms, cfg_.gate_probability);
+  const auto ok = update_with_gated_measurements(s_, ms, cfg_.gating.probability);
   r.accepted = static_cast<int>(std::count(ok.begin(), ok.end(), true));
   return r;
 }
 
 bool Estimator::make_room() {
-  if (num_landmarks() < cfg_.max_landmarks) return true;
+  if (num_landmarks() < cfg_.map.max_landmarks) return true;
   // Oldest landmark not expected in any camera this step: it has left the view.
   for (const auto& lm : s_.landmarks()) {
     auto it = tracks_.find(lm.id);
@@ -118,11 +118,12 @@ std::vector<InitOutcome> Estimator::initialise_from_matches(const std::vector<Cr
       continue;
     }
     auto r = initialise_cooperative(s_, m.cam_a, cams_[m.cam_a], m.uv_a, m.cam_b, cams_[m.cam_b],
-                                    m.uv_b, cfg_.cooperative);
-    if (!r.id && r.rejected_because == kLowParallax && cfg_.cooperative.low_parallax_inverse_depth)
+                                    m.uv_b, cfg_.initialisation, cfg_.measurement_noise);
+    if (!r.id && r.rejected_because == kLowParallax && cfg_.initialisation.low_parallax_inverse_depth)
       r = initialise_cooperative_inverse_depth(s_, m.cam_a, cams_[m.cam_a], m.uv_a, m.cam_b,
-                                               cams_[m.cam_b], m.uv_b, cfg_.inverse_depth,
-                                               cfg_.gate_probability);
+                                               cams_[m.cam_b], m.uv_b, cfg_.initialisation,
+                                               cfg_.measurement_noise,
+                                               cfg_.gating.probability);
     if (r.id) tracks_[*r.id].matched = true;  // seen now: no miss on its first step
     out.push_back(std::move(r));
   }
@@ -131,7 +132,7 @@ std::vector<InitOutcome> Estimator::initialise_from_matches(const std::vector<Cr
 
 InitOutcome Estimator::initialise_from_pixel(int cam, const Eigen::Vector2d& uv) {
   if (!make_room()) return {std::nullopt, "map full"};
-  auto r = initialise_inverse_depth(s_, cam, cams_[cam], uv, cfg_.inverse_depth);
+  auto r = initialise_inverse_depth(s_, cam, cams_[cam], uv, cfg_.initialisation, cfg_.measurement_noise);
   if (r.id) tracks_[*r.id].matched = true;
   return r;
 }
@@ -141,15 +142,19 @@ std::vector<LandmarkId> Estimator::end_step() {
   for (auto& [id, t] : tracks_) {
     if (t.expected && !t.matched) ++t.misses;
     if (t.matched) t.misses = 0;
-    if (t.misses >= cfg_.max_misses) drop.push_back(id);
+    if (t.misses >= cfg_.map.max_misses) drop.push_back(id);
     t.expected = t.matched = false;
   }
   std::sort(drop.begin(), drop.end());
   for (LandmarkId id : drop) forget(id);
-  for (int j = 0; j < num_cameras(); ++j) convert_linear_landmarks(s_, j, cfg_.linearity_threshold);
+  for (int j = 0; j < num_cameras(); ++j) convert_linear_landmarks(s_, j, cfg_.initialisation.linearity_threshold);
   std::vector<LandmarkId> removed;
   removed.swap(evicted_);
   return removed;
+}
+
+const char* to_string(EstimatorMode m) {
+  return m == EstimatorMode::SingleUav ? "single" : "multi";
 }
 
 std::optional<Eigen::Vector3d> Estimator::landmark_position(LandmarkId id) const {

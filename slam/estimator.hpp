@@ -14,31 +14,11 @@
 
 #include "slam/landmark_init.hpp"
 #include "slam/measurement_models.hpp"
+#include "slam/settings.hpp"
 #include "slam/state.hpp"
 #include "slam/visual_update.hpp"
 
 namespace wingman::slam {
-
-struct EstimatorSettings {
-  double accel_sigma_lead = 0.05, accel_sigma_uav = 0.05;  // eq. 34
-  double accel_sigma_common = 0;  // shared by every agent (motion_model.hpp)
-  // > 0: a shared acceleration state, Gauss-Markov with this std (m/s^2) and correlation time (s).
-  double common_accel_state_sigma = 0, common_accel_state_time_constant = 0;
-  double pixel_sigma = 3, gps_sigma = 1.5, altimeter_sigma = 0.5, range_sigma = 0.5;
-  double initial_position_sigma = 1e-3, initial_velocity_sigma = 1e-3;
-  // > 0: each camera's gimbal error is a Gauss-Markov state with this correlation time (s) and
-  // the camera's orientation_sigma; 0: it is white noise marginalised in every update.
-  double gimbal_time_constant = 0;
-  double gate_probability = 0.999;
-  VisualUpdateSettings visual{};
-  CooperativeInitSettings cooperative{};
-  InverseDepthInitSettings inverse_depth{};
-  double linearity_threshold = 0.1;
-  int max_landmarks = 150;
-  int max_misses = 5;
-  double image_margin_px = 10;
-  std::uint64_t seed = 1;  // for RANSAC's draws
-};
 
 struct AgentInit {
   Eigen::Vector3d position = Eigen::Vector3d::Zero(), velocity = Eigen::Vector3d::Zero();
@@ -70,8 +50,10 @@ struct SensorUpdateResult {
 
 class Estimator {
  public:
+  // `seed` seeds RANSAC's draws.
   Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
-            const std::vector<AgentInit>& camera_init, const EstimatorSettings& settings);
+            const std::vector<AgentInit>& camera_init, const EstimatorSettings& settings,
+            std::uint64_t seed = 1);
 
   int num_cameras() const { return static_cast<int>(cams_.size()); }
   const FilterState& state() const { return s_; }

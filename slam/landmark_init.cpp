@@ -115,7 +115,8 @@ WithOffsets append_pixel_offsets(const FilterState& s, const Eigen::VectorXd& va
 InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& commanded_a,
                                    const Eigen::Vector2d& uv_a, int cam_b,
                                    const CameraRig& commanded_b, const Eigen::Vector2d& uv_b,
-                                   const CooperativeInitSettings& cfg) {
+                                   const InitialisationSettings& cfg,
+                                   const MeasurementNoiseSettings& noise) {
   const CameraRig rig_a = estimated_rig(s.x, s.gimbal(cam_a), commanded_a);
   const CameraRig rig_b = estimated_rig(s.x, s.gimbal(cam_b), commanded_b);
   const int pa = FilterState::cam_pos(cam_a), pb = FilterState::cam_pos(cam_b);
@@ -141,15 +142,15 @@ InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& c
     deps.push_back({g, -Jza * pixel_gimbal_jacobian(rig_a.model, s.x(g), ray(rig_a, uv_a))});
   if (const int g = s.gimbal(cam_b); g >= 0)
     deps.push_back({g, -Jzb * pixel_gimbal_jacobian(rig_b.model, s.x(g), ray(rig_b, uv_b))});
-  const Eigen::Matrix3d pixel_cov = Jza * pixel_covariance(rig_a, pC_a, cfg.sigma_px) * Jza.transpose() +
-                                    Jzb * pixel_covariance(rig_b, pC_b, cfg.sigma_px) * Jzb.transpose();
+  const Eigen::Matrix3d pixel_cov = Jza * pixel_covariance(rig_a, pC_a, noise.pixel_sigma) * Jza.transpose() +
+                                    Jzb * pixel_covariance(rig_b, pC_b, noise.pixel_sigma) * Jzb.transpose();
   const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
-  if (!(cfg.pixel_offset_sigma > 0)) return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
+  if (!(noise.pixel_offset_sigma > 0)) return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
 
   // With pixel offsets: the point was triangulated from uv_b - o_b with o_b ~ N(0, sigma^2 I), so
   // d point / d o_b = -Jzb; the other cameras' offsets start independent of everything.
-  const double var = cfg.pixel_offset_sigma * cfg.pixel_offset_sigma;
-  auto w = append_pixel_offsets(s, t->point, cross, cov, cfg.pixel_offset_sigma);
+  const double var = noise.pixel_offset_sigma * noise.pixel_offset_sigma;
+  auto w = append_pixel_offsets(s, t->point, cross, cov, noise.pixel_offset_sigma);
   LandmarkSlot probe;  // where camera b's offset sits among the new parameters
   probe.anchor_cam = cam_a;
   probe.extra = static_cast<int>(w.value.size()) - 3;
@@ -180,11 +181,12 @@ Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x
 }
 
 InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& commanded,
-                                     const Eigen::Vector2d& uv, const InverseDepthInitSettings& cfg) {
+                                     const Eigen::Vector2d& uv, const InitialisationSettings& cfg,
+                                     const MeasurementNoiseSettings& noise) {
   const CameraRig rig = estimated_rig(s.x, s.gimbal(cam), commanded);
   const int pc = FilterState::cam_pos(cam);
   Eigen::Matrix<double, 6, 5> J;
-  const Vector6d y = inverse_depth_from_pixel(rig, s.x.segment<3>(pc), uv, cfg.rho, &J);
+  const Vector6d y = inverse_depth_from_pixel(rig, s.x.segment<3>(pc), uv, cfg.inverse_depth_rho, &J);
   // The anchor is the camera position: it inherits the camera's rows of P.
   std::vector<StateDependence> deps = {{pc, J.leftCols<3>()}};
   const Eigen::Matrix<double, 6, 2> Juv = J.rightCols<2>();
@@ -192,13 +194,13 @@ InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& c
   const Eigen::Vector3d ray_C(xn.x(), xn.y(), 1.0);
   if (const int g = s.gimbal(cam); g >= 0)
     deps.push_back({g, -Juv * pixel_gimbal_jacobian(rig.model, s.x(g), ray_C)});
-  Eigen::Matrix<double, 6, 6> pixel_cov = Juv * pixel_covariance(rig, ray_C, cfg.sigma_px) * Juv.transpose();
-  pixel_cov(5, 5) = cfg.sigma_rho * cfg.sigma_rho;  // the depth prior, independent of the state
+  Eigen::Matrix<double, 6, 6> pixel_cov = Juv * pixel_covariance(rig, ray_C, noise.pixel_sigma) * Juv.transpose();
+  pixel_cov(5, 5) = cfg.inverse_depth_sigma * cfg.inverse_depth_sigma;  // the depth prior, independent of the state
   const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
-  if (!(cfg.pixel_offset_sigma > 0) || s.num_cameras() < 2)
+  if (!(noise.pixel_offset_sigma > 0) || s.num_cameras() < 2)
     return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
   // The other cameras' offsets start at 0, independent of everything (this pixel has none).
-  const auto w = append_pixel_offsets(s, y, cross, cov, cfg.pixel_offset_sigma);
+  const auto w = append_pixel_offsets(s, y, cross, cov, noise.pixel_offset_sigma);
   return {s.add_landmark(LandmarkKind::InverseDepth, w.value, w.cross, w.cov, cam), ""};
 }
 
@@ -206,9 +208,10 @@ InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, cons
                                                  const Eigen::Vector2d& uv_a, int cam_b,
                                                  const CameraRig& commanded_b,
                                                  const Eigen::Vector2d& uv_b,
-                                                 const InverseDepthInitSettings& cfg,
+                                                 const InitialisationSettings& cfg,
+                                                 const MeasurementNoiseSettings& noise,
                                                  double gate_probability) {
-  InitOutcome r = initialise_inverse_depth(s, cam_a, commanded_a, uv_a, cfg);
+  InitOutcome r = initialise_inverse_depth(s, cam_a, commanded_a, uv_a, cfg, noise);
   if (!r.id) return r;
   const LandmarkSlot* lm = s.find(*r.id);
   const int rho = lm->offset + 5;
@@ -224,7 +227,7 @@ InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, cons
       rho_lin = 1.0 / d;
   const double rho_prior = s.x(rho);
   s.x(rho) = rho_lin;
-  std::optional<Measurement> m = landmark_measurement(s, *lm, cam_b, commanded_b, uv_b, cfg.sigma_px);
+  std::optional<Measurement> m = landmark_measurement(s, *lm, cam_b, commanded_b, uv_b, noise.pixel_sigma);
   s.x(rho) = rho_prior;
   if (m)
     for (const auto& b : m->blocks)

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "slam/measurement_models.hpp"
+#include "slam/settings.hpp"
 #include "slam/state.hpp"
 
 namespace wingman::slam {
@@ -32,22 +33,6 @@ std::optional<Triangulation> triangulate_two_views(const CameraRig& cam_a, const
                                                    const CameraRig& cam_b, const Eigen::Vector3d& x_b,
                                                    const Eigen::Vector2d& uv_b);
 
-struct CooperativeInitSettings {
-  double sigma_px = 3.0;
-  double min_parallax_deg = 3.0;
-  double max_reprojection_px = 10.0;
-  // A triangulated point nearer than this to either camera (along its optical axis, m) is a wrong
-  // pair: a match along the epipolar line that triangulates just under the cameras. 0 checks only
-  // that it lies in front of both (OpenVINS's min_dist plays the same part).
-  double min_depth_m = 0.0;
-  // Below min_parallax_deg: an inverse-depth landmark from the pair
-  // (initialise_cooperative_inverse_depth) instead of a rejection.
-  bool low_parallax_inverse_depth = false;
-  // > 0: the landmark carries each other camera's constant pixel offset from camera a's (prior
-  // N(0, sigma^2) per axis; LandmarkSlot::pixel_offset); camera b's pixel in the pair is taken
-  // with its offset, so the point's covariance grows by J_b sigma^2 J_b^T and is correlated with it.
-  double pixel_offset_sigma = 0.0;
-};
 
 // The rejection reason of a pair under min_parallax_deg.
 inline constexpr const char* kLowParallax = "low parallax";
@@ -63,16 +48,9 @@ struct InitOutcome {
 InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& commanded_a,
                                    const Eigen::Vector2d& uv_a, int cam_b,
                                    const CameraRig& commanded_b,
-                                   const Eigen::Vector2d& uv_b, const CooperativeInitSettings& cfg);
+                                   const Eigen::Vector2d& uv_b, const InitialisationSettings& cfg,
+                                   const MeasurementNoiseSettings& noise);
 
-struct InverseDepthInitSettings {
-  double sigma_px = 3.0;
-  double rho = 0.05;
-  double sigma_rho = 0.04;
-  // > 0 with more than one camera: the landmark carries the other cameras' pixel offsets from
-  // this camera's, as CooperativeInitSettings::pixel_offset_sigma.
-  double pixel_offset_sigma = 0.0;
-};
 
 // Inverse-depth parameters of the ray through uv from a camera at x_c, with d y / d(x_c, uv)
 // (6 x 5; rho does not depend on them).
@@ -80,7 +58,8 @@ Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x
                                   const Eigen::Vector2d& uv, double rho,
                                   Eigen::Matrix<double, 6, 5>* J = nullptr);
 InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& commanded,
-                                     const Eigen::Vector2d& uv, const InverseDepthInitSettings& cfg);
+                                     const Eigen::Vector2d& uv, const InitialisationSettings& cfg,
+                                     const MeasurementNoiseSettings& noise);
 
 // A cooperative pair whose parallax is too small for a Euclidean landmark (eq. 52 linearises the
 // triangulation, which is poor at low parallax): the inverse-depth landmark of camera a's pixel,
@@ -92,7 +71,8 @@ InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, cons
                                                  const Eigen::Vector2d& uv_a, int cam_b,
                                                  const CameraRig& commanded_b,
                                                  const Eigen::Vector2d& uv_b,
-                                                 const InverseDepthInitSettings& cfg,
+                                                 const InitialisationSettings& cfg,
+                                                 const MeasurementNoiseSettings& noise,
                                                  double gate_probability);
 
 // Converts inverse-depth landmarks whose linearity index (seen from camera `cam`) is below the

@@ -25,7 +25,7 @@ double gate_threshold(double probability, int dof) {
 
 VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector<CameraRig>& cams,
                                                const std::vector<Correspondence>& candidates,
-                                               const VisualUpdateSettings& cfg,
+                                               const GatingSettings& cfg, double sigma_px,
                                                std::mt19937_64& rng,
                                                const std::vector<Measurement>& companions) {
   VisualUpdateResult res;
@@ -34,13 +34,13 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
   companion_accepted->assign(companions.size(), false);
   for (size_t i = 0; i < companions.size(); ++i) {
     const auto& m = companions[i];
-    if (mahalanobis_squared(m, innovation_covariance(s, m)) > gate_threshold(cfg.gate_probability, m.dim()))
+    if (mahalanobis_squared(m, innovation_covariance(s, m)) > gate_threshold(cfg.probability, m.dim()))
       continue;
     extra.push_back(&m);
     (*companion_accepted)[i] = true;
   }
   res.accepted.assign(candidates.size(), false);
-  const double gate2 = gate_threshold(cfg.gate_probability, 2);
+  const double gate2 = gate_threshold(cfg.probability, 2);
 
   // Individual compatibility at the prior.
   std::vector<int> compatible;
@@ -49,7 +49,7 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
     const auto& c = candidates[i];
     const LandmarkSlot* lm = s.find(c.id);
     if (!lm) continue;
-    auto m = landmark_measurement(s, *lm, c.cam, cams[c.cam], c.uv, cfg.sigma_px);
+    auto m = landmark_measurement(s, *lm, c.cam, cams[c.cam], c.uv, sigma_px);
     if (!m) continue;
     if (mahalanobis_squared(*m, innovation_covariance(s, *m)) > gate2) continue;
     meas[i] = std::move(*m);
@@ -74,9 +74,9 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
   // 1-point RANSAC: each hypothesis is the state corrected by one match alone.
   std::vector<int> best;
   std::uniform_int_distribution<size_t> pick(0, compatible.size() - 1);
-  const double inlier2 = cfg.inlier_px * cfg.inlier_px;
-  int needed = cfg.max_hypotheses;
-  for (int h = 0; h < needed && h < cfg.max_hypotheses; ++h) {
+  const double inlier2 = cfg.ransac_inlier_px * cfg.ransac_inlier_px;
+  int needed = cfg.ransac_max_hypotheses;
+  for (int h = 0; h < needed && h < cfg.ransac_max_hypotheses; ++h) {
     const int i = compatible[pick(rng)];
     const Eigen::VectorXd x_h = s.x + single_measurement_correction(s, meas[i]);
     std::vector<int> inliers;
@@ -90,7 +90,7 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
       best = std::move(inliers);
       const double eps = static_cast<double>(best.size()) / compatible.size();
       needed = eps >= 1.0 ? 1
-                          : static_cast<int>(std::ceil(std::log(1 - cfg.success_probability) /
+                          : static_cast<int>(std::ceil(std::log(1 - cfg.ransac_success_probability) /
                                                        std::log(1 - eps)));
     }
   }
@@ -103,7 +103,7 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
   for (int i : compatible) {
     if (res.accepted[i]) continue;
     const auto& c = candidates[i];
-    auto m = landmark_measurement(s, *s.find(c.id), c.cam, cams[c.cam], c.uv, cfg.sigma_px);
+    auto m = landmark_measurement(s, *s.find(c.id), c.cam, cams[c.cam], c.uv, sigma_px);
     if (!m || mahalanobis_squared(*m, innovation_covariance(s, *m)) > gate2) continue;
     rescued.push_back(std::move(*m));
     rescued_idx.push_back(i);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "slam/measurement_models.hpp"
+#include "slam/settings.hpp"
 #include "slam/state.hpp"
 
 namespace wingman::slam {
@@ -20,14 +21,6 @@ struct Correspondence {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();
 };
 
-struct VisualUpdateSettings {
-  double sigma_px = 3.0;
-  double gate_probability = 0.999;
-  bool one_point_ransac = true;
-  double inlier_px = 6.0;
-  double success_probability = 0.99;
-  int max_hypotheses = 100;
-};
 
 struct VisualUpdateResult {
   std::vector<bool> accepted;  // per candidate
@@ -42,7 +35,7 @@ struct VisualUpdateResult {
 // first joint update, so the gimbal noise they share with the landmarks is modelled jointly.
 VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector<CameraRig>& cams,
                                                const std::vector<Correspondence>& candidates,
-                                               const VisualUpdateSettings& settings,
+                                               const GatingSettings& gating, double sigma_px,
                                                std::mt19937_64& rng,
                                                const std::vector<Measurement>& companions = {});
 

@@ -5,6 +5,8 @@
 // landmarks each camera still needs; slam's initialise_from_matches takes their pixel pairs.
 #pragma once
 
+#include "geometry/settings.hpp"
+
 #include <Eigen/Core>
 #include <vector>
 
@@ -53,6 +55,14 @@ struct CrossMatchSettings {
   double min_parallax_deg = 0; // slam applies its own parallax test; 0 leaves it to slam
 
   void validate() const;  // throws std::invalid_argument naming the bad value
+
+  // The frontend: section's cross_matching: map (min_parallax_deg follows the estimator's).
+  template <class V>
+  void visit(V& v) {
+    v("ratio", ratio, geometry::in(0, 1, true, false));
+    v("max_epipolar_px", max_epipolar_px, geometry::gt(0));
+    v("max_reprojection_px", max_reprojection_px, geometry::gt(0));
+  }
 };
 
 enum class PairVerdict { Accepted, Epipolar, NotTriangulated, Depth, Parallax, Reprojection };

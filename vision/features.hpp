@@ -3,6 +3,8 @@
 // lead agent's region, which moves and must not feed the map) are kept out.
 #pragma once
 
+#include "geometry/settings.hpp"
+
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
@@ -35,6 +37,27 @@ struct FeatureSettings {
   double sift_contrast = 0.02;
 
   void validate() const;  // throws std::invalid_argument naming the bad value
+
+  // The keys of the scenario's frontend: section that choose and tune the detector.
+  template <class V>
+  void visit(V& v) {
+    v.choice("detector", kind,
+             {{"orb", DetectorKind::Orb}, {"akaze", DetectorKind::Akaze}, {"sift", DetectorKind::Sift},
+              {"gftt_orb", DetectorKind::GfttOrb}});
+    v("max_features", max_features, geometry::ge(1));
+    v.pair("grid", grid_cols, grid_rows, geometry::ge(1));  // [columns, rows]
+    v.section("orb", [&](auto& o) {
+      o("fast_threshold", orb_fast_threshold, geometry::ge(1));
+      o("levels", orb_levels, geometry::ge(1));
+      o("scale_factor", orb_scale_factor, geometry::in(1, 2, true, false));
+    });
+    v.section("akaze", [&](auto& a) { a("threshold", akaze_threshold, geometry::gt(0)); });
+    v.section("sift", [&](auto& a) { a("contrast_threshold", sift_contrast, geometry::gt(0)); });
+    v.section("gftt", [&](auto& g) {
+      g("quality", gftt_quality, geometry::in(0, 1, true, true));
+      g("min_distance_px", gftt_min_distance, geometry::ge(0));
+    });
+  }
 };
 
 // An axis-aligned pixel box kept free of features, e.g. around the lead's detected or predicted

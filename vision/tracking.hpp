@@ -4,6 +4,8 @@
 // the estimator's (1-point RANSAC and chi^2 gating); this only proposes candidates.
 #pragma once
 
+#include "geometry/settings.hpp"
+
 #include <Eigen/Core>
 #include <vector>
 
@@ -38,6 +40,16 @@ struct TrackingSettings {
   double max_search_radius_px = 150.0;
 
   void validate() const;  // throws std::invalid_argument naming the bad value
+
+  // The frontend: section's tracking: map.
+  template <class V>
+  void visit(V& v) {
+    v("gate_d2", gate_d2, geometry::gt(0));
+    v("ratio", ratio, geometry::in(0, 1, true, false));
+    v("max_search_radius_px", max_search_radius_px, geometry::ge(0));
+    v("max_distance", max_distance, geometry::ge(0));
+    v("match_latest_descriptor", match_latest_descriptor);
+  }
 };
 
 struct TrackCandidate {

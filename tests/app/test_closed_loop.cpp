@@ -11,12 +11,12 @@
 
 #include "app/pipeline.hpp"
 #include "eval/metrics.hpp"
-#include "sim/scenario.hpp"
+#include "app/run_config.hpp"
 
 namespace wingman::app {
 namespace {
 
-sim::Scenario short_closed_loop() {
+app::RunConfig short_closed_loop() {
   std::ifstream in(WINGMAN_SOURCE_DIR "/scenes/paper_closed_loop_synthetic.yaml");
   std::stringstream ss;
   ss << in.rdbuf();
@@ -30,11 +30,11 @@ sim::Scenario short_closed_loop() {
   replace("from: 0, to: 70", "from: 0, to: 15");
   replace("from: 70, to: 140", "from: 15, to: 30");
   replace("from: 140, to: 210", "from: 30, to: 45");
-    return sim::parse_scenarios(y, "short_closed_loop.yaml").front();
+    return app::parse_run_configs(y, "short_closed_loop.yaml").front();
 }
 
 TEST(ClosedLoop, FliesIntoTheFormation) {
-  const sim::Scenario scn = short_closed_loop();
+  const app::RunConfig scn = short_closed_loop();
   ASSERT_TRUE(scn.closed_loop());
   const auto rec = run_synthetic(scn);
   ASSERT_TRUE(rec.closed_loop);
@@ -74,7 +74,7 @@ TEST(ClosedLoop, FliesIntoTheFormation) {
 }
 
 TEST(ClosedLoop, IsReproducible) {
-  const sim::Scenario scn = short_closed_loop();
+  const app::RunConfig scn = short_closed_loop();
   const auto a = run_synthetic(scn), b = run_synthetic(scn);
   ASSERT_EQ(a.steps.size(), b.steps.size());
   const auto& fa = a.steps.back().formation[1];

@@ -13,14 +13,14 @@
 #include <string>
 
 #include "app/pipeline.hpp"
-#include "sim/scenario.hpp"
+#include "app/run_config.hpp"
 #include "slam/state.hpp"
 
 namespace wingman::app {
 namespace {
 
-sim::Scenario smoke_variant(const std::string& variant) {
-  const auto all = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/smoke.yaml");
+app::RunConfig smoke_variant(const std::string& variant) {
+  const auto all = app::load_run_configs(WINGMAN_SOURCE_DIR "/scenes/smoke.yaml");
   for (const auto& s : all)
     if (s.variant == variant) return s;
   ADD_FAILURE() << "smoke.yaml has no variant " << variant;
@@ -74,7 +74,7 @@ StateObserver covariance_checker(CovarianceLog& log) {
 class PipelineVariant : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(PipelineVariant, CovarianceStaysSymmetricPositiveDefinite) {
-  const sim::Scenario scn = smoke_variant(GetParam());
+  const app::RunConfig scn = smoke_variant(GetParam());
   CovarianceLog log;
   int progress_calls = 0, progress_total = -1;
   const auto rec = run_synthetic(
@@ -100,9 +100,9 @@ TEST_P(PipelineVariant, CovarianceStaysSymmetricPositiveDefinite) {
 // The same with the shared Gauss-Markov acceleration in the state (process_noise.
 // common_acceleration_state): three more agent states, still SPD, and the agents' NEES stays finite.
 TEST(Pipeline, CovarianceStaysSymmetricPositiveDefiniteWithTheCommonAccelerationState) {
-  sim::Scenario scn = smoke_variant("multi");
-  scn.estimator.common_accel_state_sigma = 0.05;
-  scn.estimator.common_accel_state_time_constant = 60;
+  app::RunConfig scn = smoke_variant("multi");
+  scn.estimator.process_noise.common_state_sigma = 0.05;
+  scn.estimator.process_noise.common_state_time_constant = 60;
   CovarianceLog log;
   const auto rec = run_synthetic(scn, {}, covariance_checker(log));
   EXPECT_EQ(log.calls, scn.num_steps());
@@ -114,7 +114,7 @@ TEST(Pipeline, CovarianceStaysSymmetricPositiveDefiniteWithTheCommonAcceleration
 }
 
 TEST_P(PipelineVariant, RunRecordIsComplete) {
-  const sim::Scenario scn = smoke_variant(GetParam());
+  const app::RunConfig scn = smoke_variant(GetParam());
   const auto rec = run_synthetic(scn);
   const bool multi = GetParam() == "multi";
   ASSERT_EQ(static_cast<int>(rec.steps.size()), scn.num_steps() + 1);
@@ -174,7 +174,7 @@ INSTANTIATE_TEST_SUITE_P(Smoke, PipelineVariant, ::testing::Values("multi", "sin
 // Bounds a correct filter meets on smoke (multi-UAV). Observed with seed 1 when written: see
 // the printed line; the bounds leave a wide margin above that.
 TEST(PipelineSmoke, MultiUavLeadErrorStaysBoundedAndNeesFinite) {
-  const sim::Scenario scn = smoke_variant("multi");
+  const app::RunConfig scn = smoke_variant("multi");
   const auto rec = run_synthetic(scn);
   ASSERT_EQ(static_cast<int>(rec.steps.size()), scn.num_steps() + 1);
   constexpr double kMaxLeadError = 3.0;  // m, at every step
@@ -211,16 +211,16 @@ TEST(PipelineSmoke, MultiUavLeadErrorStaysBoundedAndNeesFinite) {
 // the multi-UAV cameras fill up with their own inverse-depth landmarks (none without the key),
 // and the estimate stays as bounded as the cooperative-only one.
 TEST(PipelineSmoke, MonocularFillAddsInverseDepthLandmarksInMultiUavMode) {
-  sim::Scenario scn = smoke_variant("multi");
-  scn.estimator.target_landmarks_per_camera = 40;
-  scn.estimator.low_parallax_inverse_depth = false;  // only pairs over 8 degrees: the middle
+  app::RunConfig scn = smoke_variant("multi");
+  scn.estimator.map.target_per_camera = 40;
+  scn.estimator.initialisation.low_parallax_inverse_depth = false;  // only pairs over 8 degrees: the middle
   auto inverse_depth_count = [](const eval::RunRecord& r) {
     return std::count_if(r.landmarks.begin(), r.landmarks.end(),
                          [](const eval::LandmarkRecord& l) { return l.origin == "inverse_depth"; });
   };
   const auto without = run_synthetic(scn);
   EXPECT_EQ(inverse_depth_count(without), 0);
-  scn.estimator.monocular_fill = true;
+  scn.estimator.initialisation.monocular_fill = true;
   const auto with = run_synthetic(scn);
   EXPECT_GT(inverse_depth_count(with), 20);
   EXPECT_GT(with.landmarks.size(), without.landmarks.size());
@@ -236,7 +236,7 @@ TEST(PipelineSmoke, MonocularFillAddsInverseDepthLandmarksInMultiUavMode) {
 // without 0.0532 / 0.0408 m^2 (Z1 / X1), with 0.0015 / 0.0024 (docs/results.md); P stays
 // symmetric positive definite (checked every 20th step: the eigen-decomposition is the cost).
 TEST(PipelineTrackBias, PixelOffsetsUndoWhatPerTrackPixelOffsetsDoToMultiUav) {
-  const auto all = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic_track_bias.yaml");
+  const auto all = app::load_run_configs(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic_track_bias.yaml");
   auto variant = [&](const std::string& name) {
     for (const auto& s : all)
       if (s.variant == name) return s;
@@ -248,7 +248,7 @@ TEST(PipelineTrackBias, PixelOffsetsUndoWhatPerTrackPixelOffsetsDoToMultiUav) {
     for (const auto& st : r.steps) sum += (st.agents[1].p_est - st.agents[1].p_true).cwiseAbs2();
     return Eigen::Vector3d(sum / static_cast<double>(r.steps.size()));
   };
-  sim::Scenario without = variant("multi"), with = variant("multi_offsets_lp");
+  app::RunConfig without = variant("multi"), with = variant("multi_offsets_lp");
   without.seed = with.seed = 3;
   const auto plain = run_synthetic(without);
   CovarianceLog log;
@@ -270,7 +270,7 @@ TEST(PipelineTrackBias, PixelOffsetsUndoWhatPerTrackPixelOffsetsDoToMultiUav) {
 
 TEST(PipelineSmoke, SameSeedGivesIdenticalEstimates) {
   for (const std::string variant : {"multi", "single"}) {
-    const sim::Scenario scn = smoke_variant(variant);
+    const app::RunConfig scn = smoke_variant(variant);
     const auto a = run_synthetic(scn);
     const auto b = run_synthetic(scn);
     ASSERT_EQ(a.steps.size(), b.steps.size());
@@ -289,7 +289,7 @@ TEST(PipelineSmoke, SameSeedGivesIdenticalEstimates) {
 }
 
 TEST(PipelineSmoke, DifferentSeedGivesDifferentEstimates) {
-  sim::Scenario scn = smoke_variant("multi");
+  app::RunConfig scn = smoke_variant("multi");
   const auto a = run_synthetic(scn);
   scn.seed += 1;
   const auto b = run_synthetic(scn);

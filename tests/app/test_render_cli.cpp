@@ -10,6 +10,7 @@
 #include <chrono>
 #include <thread>
 
+#include "app/run_config.hpp"
 #include "app_test_support.hpp"
 #include "datasets/dataset.hpp"
 #include "render/gl_context.hpp"
@@ -58,7 +59,7 @@ TEST(RenderCli, WritesADatasetThatReadsBackAndMatchesADirectRender) {
   } catch (const render::GlContextError& e) {
     GTEST_SKIP() << e.what();
   }
-  sim::Scenario s = sim::load_scenarios(scn.string()).front();
+  app::RunConfig s = app::load_run_configs(scn.string()).front();
   s.seed = 5;
   const sim::OpenLoopTruth truth(s);
   render::Renderer renderer(*ctx, render::build_scene(s));

@@ -14,15 +14,15 @@
 #include "eval/metrics.hpp"
 #include "eval/writers.hpp"
 #include "render/gl_context.hpp"
-#include "sim/scenario.hpp"
+#include "app/run_config.hpp"
 
 namespace wingman::app::test {
 namespace {
 
 const fs::path kRenderedSmoke = kSourceDir / "scenes" / "rendered_smoke.yaml";
 
-sim::Scenario variant(const std::string& name) {
-  for (auto& s : sim::load_scenarios(kRenderedSmoke.string()))
+app::RunConfig variant(const std::string& name) {
+  for (auto& s : app::load_run_configs(kRenderedSmoke.string()))
     if (s.variant == name) return s;
   throw std::runtime_error("no variant " + name);
 }
@@ -43,7 +43,7 @@ bool gl_available(std::string* why) {
 TEST(RenderedPipeline, SmokeRunMeetsIssueSixTargets) {
   std::string why;
   if (!gl_available(&why)) GTEST_SKIP() << why;
-  const sim::Scenario scn = variant("multi");
+  const app::RunConfig scn = variant("multi");
   TempDir dir;
   const fs::path video = dir / "run.avi";
   RenderedOptions ro(render::GlBackend::Auto, video.string());
@@ -139,7 +139,7 @@ TEST(RenderedPipeline, SmokeRunMeetsIssueSixTargets) {
 TEST(RenderedPipeline, SingleUavBaselineRunsOnQuadOnesFramesAlone) {
   std::string why;
   if (!gl_available(&why)) GTEST_SKIP() << why;
-  sim::Scenario s = variant("single");
+  app::RunConfig s = variant("single");
   s.duration = 3;
   const auto rec = run_scenario(s, render::GlBackend::Auto);
   EXPECT_EQ(rec.agent_names, (std::vector<std::string>{"lead", "uav1"}));
@@ -155,7 +155,7 @@ TEST(RenderedPipeline, SingleUavBaselineRunsOnQuadOnesFramesAlone) {
 TEST(RenderedPipeline, OraclePixelsFeedExactProjectionsOfCorrectCorrespondences) {
   std::string why;
   if (!gl_available(&why)) GTEST_SKIP() << why;
-  sim::Scenario s = variant("multi");
+  app::RunConfig s = variant("multi");
   s.duration = 4;
   s.frontend.oracle_pixels = true;
   const auto rec = run_scenario(s, render::GlBackend::Auto);
@@ -181,7 +181,7 @@ TEST(RenderedPipeline, OraclePixelsFeedExactProjectionsOfCorrectCorrespondences)
 TEST(RenderedPipeline, PrefetchChangesTimingOnly) {
   std::string why;
   if (!gl_available(&why)) GTEST_SKIP() << why;
-  sim::Scenario s = variant("multi");
+  app::RunConfig s = variant("multi");
   s.duration = 3;
   RenderedOptions on, off;
   off.prefetch = false;
@@ -271,8 +271,8 @@ TEST(RenderedPipeline, SlamAndBenchFrontendReplayARenderedDataset) {
 TEST(RenderedPipeline, ClosedLoopRunsOnRenderedFrames) {
   std::string why;
   if (!gl_available(&why)) GTEST_SKIP() << why;
-  sim::Scenario s =
-      sim::load_scenarios((kSourceDir / "scenes" / "paper_closed_loop_rendered.yaml").string()).front();
+  app::RunConfig s =
+      app::load_run_configs((kSourceDir / "scenes" / "paper_closed_loop_rendered.yaml").string()).front();
   ASSERT_TRUE(s.closed_loop());
   s.duration = 2;
   const auto rec = run_scenario(s, render::GlBackend::Auto);

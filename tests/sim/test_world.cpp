@@ -62,10 +62,10 @@ TEST(World, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(error_of("world:\n  terrain: {relif: 1}\n"),
             "w.yaml:2:13: world.terrain.relif: unknown key 'relif' (did you mean 'relief'?)");
   EXPECT_NE(error_of("world:\n  texture: {mode: mirrored}\n")
-                .find("w.yaml:2:19: world.texture.mode: unknown value 'mirrored'"),
+                .find("w.yaml:2:19: world.texture.mode: expected one of tiled, stretched, got 'mirrored'"),
             std::string::npos);
   EXPECT_NE(error_of("world:\n  texture: {filter: nearest}\n")
-                .find("w.yaml:2:21: world.texture.filter: unknown value 'nearest'"),
+                .find("w.yaml:2:21: world.texture.filter: expected one of trilinear, bilinear, got 'nearest'"),
             std::string::npos);
   EXPECT_NE(error_of("world:\n  image: {msaa: 3}\n").find("world.image.msaa: must be 1, 2, 4, 8 or 16"),
             std::string::npos);

@@ -142,8 +142,8 @@ class BuilderTest : public ::testing::TestWithParam<bool> {
             *project_point(estimated_rig(s.x, s.gimbal(1), rig), s.x.segment<3>(FilterState::cam_pos(1)), X)};
   }
   // Cooperative initialisation that accepts any pair, so the tests see the covariance of each.
-  static CooperativeInitSettings accept_any_pair() {
-    CooperativeInitSettings c;
+  static InitialisationSettings accept_any_pair() {
+    InitialisationSettings c;
     c.min_parallax_deg = 0;
     c.max_reprojection_px = 1e9;
     return c;
@@ -209,20 +209,20 @@ TEST_P(BuilderTest, NewLandmarkCrossCovarianceIsItsStateJacobian) {
   const CameraRig rig = tilted_rig(true);
   const auto [uv_a, uv_b] = predicted_pair(s, rig, Eigen::Vector3d(3, -2, 0.4));
   const Eigen::Vector2d uv_c(420.5, 610.1);
-  const CooperativeInitSettings coop = accept_any_pair();
-  InverseDepthInitSettings idp;
+  const InitialisationSettings coop = accept_any_pair();
+  const MeasurementNoiseSettings noise;
 
   using Init = std::function<Eigen::VectorXd(FilterState&)>;
   const std::vector<std::pair<const char*, Init>> inits = {
       {"cooperative",
        [&](FilterState& st) {
-         auto r = initialise_cooperative(st, 0, rig, uv_a, 1, rig, uv_b, coop);
+         auto r = initialise_cooperative(st, 0, rig, uv_a, 1, rig, uv_b, coop, noise);
          EXPECT_TRUE(r.id.has_value()) << r.rejected_because;
          return Eigen::VectorXd(st.x.tail(3));
        }},
       {"inverse depth",
        [&](FilterState& st) {
-         auto r = initialise_inverse_depth(st, 1, rig, uv_c, idp);
+         auto r = initialise_inverse_depth(st, 1, rig, uv_c, coop, noise);
          EXPECT_TRUE(r.id.has_value()) << r.rejected_because;
          return Eigen::VectorXd(st.x.tail(6));
        }},
@@ -250,12 +250,13 @@ TEST_P(BuilderTest, CooperativeLandmarkWithPixelOffsetsCarriesTheirCovariance) {
   const FilterState s = two_uav_state(GetParam());
   const CameraRig rig = tilted_rig(true);
   const auto [uv_a, uv_b] = predicted_pair(s, rig, Eigen::Vector3d(3, -2, 0.4));
-  CooperativeInitSettings coop = accept_any_pair();
+  const InitialisationSettings coop = accept_any_pair();
+  MeasurementNoiseSettings noise;
   FilterState plain = s;
-  ASSERT_TRUE(initialise_cooperative(plain, 0, rig, uv_a, 1, rig, uv_b, coop).id);
-  coop.pixel_offset_sigma = 0.75;
+  ASSERT_TRUE(initialise_cooperative(plain, 0, rig, uv_a, 1, rig, uv_b, coop, noise).id);
+  noise.pixel_offset_sigma = 0.75;
   FilterState t = s;
-  ASSERT_TRUE(initialise_cooperative(t, 0, rig, uv_a, 1, rig, uv_b, coop).id);
+  ASSERT_TRUE(initialise_cooperative(t, 0, rig, uv_a, 1, rig, uv_b, coop, noise).id);
   const LandmarkSlot& lm = t.landmarks().back();
   ASSERT_EQ(lm.dim(), 5);
   ASSERT_EQ(lm.anchor_cam, 0);
@@ -268,9 +269,9 @@ TEST_P(BuilderTest, CooperativeLandmarkWithPixelOffsetsCarriesTheirCovariance) {
   // d point / d uv_b by re-triangulating from shifted pixels.
   auto point_from = [&](const Eigen::VectorXd& uv) -> Eigen::VectorXd {
     FilterState u = s;
-    CooperativeInitSettings c = coop;
-    c.pixel_offset_sigma = 0;
-    EXPECT_TRUE(initialise_cooperative(u, 0, rig, uv_a, 1, rig, uv, c).id);
+    MeasurementNoiseSettings white = noise;
+    white.pixel_offset_sigma = 0;
+    EXPECT_TRUE(initialise_cooperative(u, 0, rig, uv_a, 1, rig, uv, coop, white).id);
     return u.x.tail<3>();
   };
   const Eigen::MatrixXd Jb = numerical_jacobian(point_from, Eigen::VectorXd(uv_b));

@@ -1,23 +1,26 @@
-// The control: section (closed loop, paper section 6 and 7.3): defaults, overrides, and errors
-// that name the file, line and key.
+// The control: section (closed loop, paper section 6 and 7.3): sim's part (initial yaws, desired
+// formation, Delta_g, settling time) and the controller's (gains, switching, limits) read from one
+// map, with defaults, overrides, and errors that name the file, line and key.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <string>
 
-#include "sim/closed_loop_truth.hpp"
-#include "sim/scenario.hpp"
+#include "app/run_config.hpp"
 
-namespace wingman::sim {
+namespace wingman::app {
 namespace {
 
 using ::testing::HasSubstr;
 
+std::vector<RunConfig> parse_scenarios(const std::string& text, const std::string& origin) {
+  return parse_run_configs(text, origin);
+}
+
 std::string error_of(const std::string& yaml) {
   try {
     parse_scenarios(yaml, "cl.yaml");
-  } catch (const ScenarioError& e) {
+  } catch (const sim::ScenarioError& e) {
     return e.what();
   }
   ADD_FAILURE() << "expected a ScenarioError for:\n" << yaml;
@@ -39,7 +42,7 @@ TEST(ControlSpec, EmptySectionGivesSection73Defaults) {
   EXPECT_FALSE(s.control.uavs[0].yaw_d.has_value());
   EXPECT_EQ(s.control.uavs[1].initial_yaw, 0.5);
   EXPECT_EQ(s.control.uavs[1].lambda_d, Eigen::Vector3d(0.5, -1, 16));
-  EXPECT_EQ(s.control.switching, SwitchingSpec::Saturation);
+  EXPECT_EQ(s.controller.switching, control::Switching::Saturation);
   EXPECT_EQ(s.control.settling_time, 10.0);
   EXPECT_EQ(s.control.disturbance_bound, Eigen::Vector4d::Zero());
 }
@@ -55,11 +58,11 @@ TEST(ControlSpec, Overrides) {
     - {name: uav1, initial_yaw: -0.5, lambda_d: [1, 2, 3], yaw_d: 0.25}
     - {name: uav2}
 )", "a.yaml").front();
-  EXPECT_EQ(s.control.k1, Eigen::Vector4d::Constant(0.4));
-  EXPECT_EQ(s.control.k2, Eigen::Vector4d(2, 2, 1.5, 0.7));
-  EXPECT_EQ(s.control.switching, SwitchingSpec::Tanh);
-  EXPECT_EQ(s.control.max_horizontal_speed, 3.0);
-  EXPECT_EQ(s.control.max_acceleration, 0.0);
+  EXPECT_EQ(s.controller.k1, Eigen::Vector4d::Constant(0.4));
+  EXPECT_EQ(s.controller.k2, Eigen::Vector4d(2, 2, 1.5, 0.7));
+  EXPECT_EQ(s.controller.switching, control::Switching::Tanh);
+  EXPECT_EQ(s.controller.max_horizontal_speed, 3.0);
+  EXPECT_EQ(s.controller.max_acceleration, 0.0);
   EXPECT_EQ(*s.control.disturbance_seed, 9u);
   EXPECT_EQ(s.control.uavs[0].yaw_d, std::optional<double>(0.25));
   EXPECT_EQ(s.control.uavs[0].lambda_d, Eigen::Vector3d(1, 2, 3));
@@ -73,7 +76,7 @@ TEST(ControlSpec, Errors) {
   EXPECT_THAT(error_of("control:\n  k1: [1, 1, 1]\n"),
               HasSubstr("control.k1: expected a number or a list of 4 numbers"));
   EXPECT_THAT(error_of("control:\n  switching: sgn\n"),
-              HasSubstr("cl.yaml:2:14: control.switching: expected sign, sat or tanh, got 'sgn'"));
+              HasSubstr("cl.yaml:2:14: control.switching: expected one of sign, sat, tanh, got 'sgn'"));
   EXPECT_THAT(error_of("control:\n  uavs:\n    - {name: uav1, yaw_d: north}\n    - {name: uav2}\n"),
               HasSubstr("control.uavs[0].yaw_d: expected lead_bearing or a yaw in radians"));
   EXPECT_THAT(error_of("control:\n  uavs:\n    - {name: uav1}\n"),
@@ -86,30 +89,5 @@ TEST(ControlSpec, Errors) {
               HasSubstr("closed loop (the control: section) needs mode multi"));
 }
 
-TEST(ClosedLoopTruth, StartsAtTheSpecAndRefusesOtherTimes) {
-  const auto s = parse_scenarios("control: {}\n", "a.yaml").front();
-  ClosedLoopTruth truth(s);
-  EXPECT_EQ(truth.uav(0, 0.0).position, Eigen::Vector3d(-1.5, 0, 15));
-  EXPECT_EQ(truth.uav_yaw(1, 0.0), 0.5);
-  EXPECT_THROW(truth.uav(0, 0.1), std::logic_error);
-  truth.set_uav(0, {1, 2, 3}, {0, 0, 0}, 0.2);
-  truth.set_time(0.1);
-  EXPECT_EQ(truth.camera(0, 0.1).position, Eigen::Vector3d(1, 2, 3));
-}
-
-TEST(InputDisturbance, BoundedAndReproducible) {
-  const Eigen::Vector4d bound(0.3, 0.2, 0.1, 0.05);
-  const InputDisturbance a(bound, 2, 7), b(bound, 2, 7), c(bound, 2, 8);
-  Eigen::Vector4d peak = Eigen::Vector4d::Zero();
-  for (int k = 0; k < 5000; ++k) {
-    const Eigen::Vector4d d = a(1, k * 0.1);
-    EXPECT_TRUE(((d.cwiseAbs() - bound).array() <= 1e-12).all());
-    peak = peak.cwiseMax(d.cwiseAbs());
-    EXPECT_EQ(d, b(1, k * 0.1));
-  }
-  EXPECT_TRUE(((peak.array() / bound.array()) > 0.7).all());  // it does use its bound
-  EXPECT_NE(a(0, 3.0), c(0, 3.0));
-}
-
 }  // namespace
-}  // namespace wingman::sim
+}  // namespace wingman::app

@@ -1,0 +1,52 @@
+// One definition per setting. A module's settings struct names each of its keys once, in a
+// `visit` member template:
+//
+//   template <class V> void visit(V& v) {
+//     v("pixel_sigma", pixel_sigma, ge(0));
+//     v.section("gating", [&](auto& g) { g("probability", gate_probability, in(0, 1, true, true)); });
+//   }
+//
+// and every walker of settings is such a V: the scenario reader (app/settings_yaml.hpp) fills the
+// struct from YAML with file:line:key errors, the printer writes the resolved values, the
+// documentation test compares docs/scenario.md with the defaults. A visitor takes
+//   v(key, double&, Bounds)   v(key, int&, Bounds)   v(key, bool&)   v(key, std::string&)
+//   v(key, Eigen::Vector3d&)  v(key, Eigen::Vector4d&, Bounds)
+//   v.choice(key, E&, {{"name", E::Value}, ...})
+//   v.section(key, [&](auto& sub) { ... })
+// Keys are YAML keys; the struct's field names may differ (the code's names stay frame- and
+// unit-explicit).
+#pragma once
+
+#include <cstdint>
+#include <initializer_list>
+#include <limits>
+#include <string_view>
+#include <utility>
+
+namespace wingman::geometry {
+
+// The admissible range of a number: [lo, hi] with either end open.
+struct Bounds {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false, hi_open = false;
+
+  bool ok(double v) const {
+    if (lo_open ? !(v > lo) : !(v >= lo)) return false;
+    if (hi_open ? !(v < hi) : !(v <= hi)) return false;
+    return true;
+  }
+};
+
+inline Bounds any_value() { return {}; }
+inline Bounds ge(double lo) { return {lo, std::numeric_limits<double>::infinity(), false, false}; }
+inline Bounds gt(double lo) { return {lo, std::numeric_limits<double>::infinity(), true, false}; }
+inline Bounds in(double lo, double hi, bool lo_open = false, bool hi_open = false) {
+  return {lo, hi, lo_open, hi_open};
+}
+
+// The names an enum takes in files, in the order they are listed to a user.
+template <typename E>
+using Choices = std::initializer_list<std::pair<std::string_view, E>>;
+
+}  // namespace wingman::geometry

@@ -1,0 +1,196 @@
+// Walkers of settings structs (geometry/settings.hpp) over YAML: read_settings fills a struct from
+// one map of a scenario file, strictly (sim/yaml_input.hpp: unknown keys with a "did you mean",
+// duplicate keys, types and ranges, each naming file:line:col and the key path); emit_settings
+// writes the resolved values back as YAML.
+#pragma once
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "geometry/camera.hpp"
+#include "geometry/settings.hpp"
+#include "sim/yaml_input.hpp"
+
+namespace wingman::sim {
+
+// Where each key that was read came from, by key path ("estimator.map.max_landmarks").
+using KeyLocations = std::map<std::string, Loc>;
+
+namespace settings_detail {
+
+// First pass over one map level: the keys it accepts.
+struct KeyLister {
+  std::vector<std::string_view> keys;
+  template <typename T, typename... Rest>
+  void operator()(std::string_view key, T&, Rest&&...) { keys.push_back(key); }
+  template <typename E>
+  void choice(std::string_view key, E&, geometry::Choices<E>) { keys.push_back(key); }
+  template <typename Fn>
+  void section(std::string_view key, Fn&&) { keys.push_back(key); }
+  void pair(std::string_view key, int&, int&, geometry::Bounds = {}) { keys.push_back(key); }
+  void check(std::string_view, bool, std::string_view) {}
+  void other(std::string_view key) { keys.push_back(key); }
+};
+
+int to_int_bound(double v, int fallback);
+
+// Second pass: reads the keys present in the map.
+class Reader {
+ public:
+  Reader(const Ctx& ctx, const Field& f, std::vector<std::string_view> keys, KeyLocations* where)
+      : ctx_(ctx), map_(ctx, f, std::move(keys)), map_loc_(f.loc()), where_(where) {}
+
+  void operator()(std::string_view key, double& x, geometry::Bounds b = {}) {
+    if (auto f = get(key)) x = read_number(ctx_, *f, b);
+  }
+  void operator()(std::string_view key, float& x, geometry::Bounds b = {}) {
+    if (auto f = get(key)) x = static_cast<float>(read_number(ctx_, *f, b));
+  }
+  void operator()(std::string_view key, int& x, geometry::Bounds b = {}) {
+    if (auto f = get(key))
+      x = read_int(ctx_, *f, to_int_bound(b.lo, std::numeric_limits<int>::min()),
+                   to_int_bound(b.hi, std::numeric_limits<int>::max()));
+  }
+  void operator()(std::string_view key, bool& x) {
+    if (auto f = get(key)) x = read_bool(ctx_, *f);
+  }
+  void operator()(std::string_view key, std::string& x) {
+    if (auto f = get(key)) x = read_string(ctx_, *f);
+  }
+  void operator()(std::string_view key, Eigen::Vector3d& x, geometry::Bounds b = {}) {
+    if (auto f = get(key)) x = read_vec3(ctx_, *f, b);
+  }
+  void operator()(std::string_view key, geometry::Distortion& x) {
+    if (auto f = get(key)) x = read_distortion(ctx_, *f);
+  }
+  // A key of this map that another reader reads.
+  void other(std::string_view) {}
+  // A condition on values already read: fails at `key` (or at the map when the key is absent).
+  void check(std::string_view key, bool ok, std::string_view what) {
+    if (ok) return;
+    auto f = map_.get(key);
+    ctx_.fail(f ? f->loc() : Loc{map_loc_.mark, child_path(map_loc_.path, key)}, std::string(what));
+  }
+  void operator()(std::string_view key, Eigen::Vector4d& x, geometry::Bounds b = {}) {
+    if (auto f = get(key)) x = read_vec4(ctx_, *f, b);
+  }
+  template <typename E>
+  void choice(std::string_view key, E& x, geometry::Choices<E> choices) {
+    auto f = get(key);
+    if (!f) return;
+    std::vector<std::string_view> names;
+    for (const auto& [name, value] : choices) names.push_back(name);
+    const std::string& s = scalar_of(ctx_, *f, fmt::format("one of {}", join(names)));
+    for (const auto& [name, value] : choices)
+      if (s == name) {
+        x = value;
+        return;
+      }
+    ctx_.fail(f->loc(), fmt::format("expected one of {}, got '{}'{}", join(names), s, suggestion(s, names)));
+  }
+  template <typename Fn>
+  void section(std::string_view key, Fn&& fn) {
+    if (auto f = get(key)) read_map(ctx_, *f, fn, where_);
+  }
+  // Two integers written as [a, b].
+  void pair(std::string_view key, int& a, int& b, geometry::Bounds bounds = {}) {
+    auto f = get(key);
+    if (!f) return;
+    if (!f->node.IsSequence() || f->node.size() != 2)
+      ctx_.fail(f->loc(), fmt::format("expected a list of 2 integers, got {}", describe(f->node)));
+    int* out[2] = {&a, &b};
+    for (std::size_t i = 0; i < 2; ++i)
+      *out[i] = read_int(ctx_, Field{f->node[i], f->key_mark, index_path(f->path, i)},
+                         to_int_bound(bounds.lo, std::numeric_limits<int>::min()),
+                         to_int_bound(bounds.hi, std::numeric_limits<int>::max()));
+  }
+
+  template <typename Fn>
+  static void read_map(const Ctx& ctx, const Field& f, Fn& fn, KeyLocations* where) {
+    KeyLister lister;
+    fn(lister);
+    Reader r(ctx, f, std::move(lister.keys), where);
+    fn(r);
+  }
+
+ private:
+  std::optional<Field> get(std::string_view key) {
+    auto f = map_.get(key);
+    if (f && where_) (*where_)[f->path] = f->loc();
+    return f;
+  }
+  const Ctx& ctx_;
+  MapView map_;
+  Loc map_loc_;
+  KeyLocations* where_;
+};
+
+// Writes every key with its value, sections as nested maps.
+class Emitter {
+ public:
+  explicit Emitter(YAML::Emitter& out) : out_(out) {}
+  template <typename T, typename... Rest>
+  void operator()(std::string_view key, const T& x, Rest&&...) {
+    out_ << YAML::Key << std::string(key) << YAML::Value;
+    put(x);
+  }
+  template <typename E>
+  void choice(std::string_view key, const E& x, geometry::Choices<E> choices) {
+    for (const auto& [name, value] : choices)
+      if (value == x) out_ << YAML::Key << std::string(key) << YAML::Value << std::string(name);
+  }
+  template <typename Fn>
+  void section(std::string_view key, Fn&& fn) {
+    out_ << YAML::Key << std::string(key) << YAML::Value << YAML::BeginMap;
+    fn(*this);
+    out_ << YAML::EndMap;
+  }
+  void check(std::string_view, bool, std::string_view) {}
+  void other(std::string_view) {}
+  void pair(std::string_view key, int a, int b, geometry::Bounds = {}) {
+    out_ << YAML::Key << std::string(key) << YAML::Value << YAML::Flow << YAML::BeginSeq << a << b
+         << YAML::EndSeq;
+  }
+
+ private:
+  void put(double x) { out_ << number_text(x); }
+  void put(float x) { out_ << fmt::format("{}", x); }
+  void put(int x) { out_ << x; }
+  void put(bool x) { out_ << (x ? "true" : "false"); }
+  void put(const std::string& x) { out_ << x; }
+  void put(const geometry::Distortion& d) { put(Eigen::Matrix<double, 5, 1>(d.k1, d.k2, d.p1, d.p2, d.k3)); }
+  template <int N>
+  void put(const Eigen::Matrix<double, N, 1>& v) {
+    out_ << YAML::Flow << YAML::BeginSeq;
+    for (int i = 0; i < N; ++i) out_ << number_text(v[i]);
+    out_ << YAML::EndSeq;
+  }
+  static std::string number_text(double x) { return fmt::format("{}", x); }
+  YAML::Emitter& out_;
+};
+
+}  // namespace settings_detail
+
+// Fills `settings` from the map `f`; keys absent keep their values.
+template <typename S>
+void read_settings(const Ctx& ctx, const Field& f, S& settings, KeyLocations* where = nullptr) {
+  auto fn = [&](auto& v) { settings.visit(v); };
+  settings_detail::Reader::read_map(ctx, f, fn, where);
+}
+
+// Writes `settings` as the value of `key` in the map being emitted.
+template <typename S>
+void emit_settings(YAML::Emitter& out, std::string_view key, const S& settings) {
+  S copy = settings;  // visit() is one list for reading and writing, so it takes a mutable struct
+  settings_detail::Emitter e(out);
+  e.section(key, [&](auto& v) { copy.visit(v); });
+}
+
+}  // namespace wingman::sim

@@ -1,0 +1,31 @@
+// The vision frontend's settings: the `frontend:` section of a scenario (rendered measurements),
+// defined once by the structs of the stages that use them.
+#pragma once
+
+#include "vision/cross_match.hpp"
+#include "vision/features.hpp"
+#include "vision/tracking.hpp"
+
+namespace wingman::vision {
+
+struct FrontendSettings {
+  FeatureSettings features{};
+  TrackingSettings tracking{};
+  CrossMatchSettings cross_matching{};
+  // Diagnostic ablation, never for reported figures: every correspondence the frontend got right
+  // (ground-truth label inlier; a detected lead within the match radius) reaches the estimator at
+  // its exact true projection instead of its measured pixel. Data association, wrong matches and
+  // what is found stay the frontend's, so a run separates the estimator's error from the pixel
+  // noise of detection (docs/pipeline_rendered.md).
+  bool oracle_pixels = false;
+
+  template <class V>
+  void visit(V& v) {
+    features.visit(v);
+    v.section("tracking", [&](auto& t) { tracking.visit(t); });
+    v.section("cross_matching", [&](auto& c) { cross_matching.visit(c); });
+    v("oracle_pixels", oracle_pixels);
+  }
+};
+
+}  // namespace wingman::vision
