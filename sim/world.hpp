@@ -98,7 +98,7 @@ struct LeadModelSpec {
   double yaw_offset = 0;     // rad, added to the heading so the model's front points forward
   Cue cue = Cue::Aruco;
   int aruco_id = 0;                 // from DICT_4X4_50
-  double marker_size = 2.0;         // m, the black square of the marker (or the panel's side)
+  double marker_size = 1.8;         // m, the black square of the marker (or the panel's side)
   Eigen::Vector3d panel_colour{1.0, 0.0, 1.0};  // cue: panel
 
   template <class V>

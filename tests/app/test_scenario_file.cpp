@@ -677,5 +677,47 @@ TEST(ScenarioYaml, PixelBiasAndPixelOffsetSigmasParseAndMustBeNonNegative) {
   EXPECT_NE(e2.find("pixel_offset_sigma"), std::string::npos) << e2;
 }
 
+// A configuration of Table 1 is defined by its sensors: needing one that nothing in the filter
+// carries is an error naming the phase and the sensor, unless the phase removes it on purpose.
+TEST(ScenarioYaml, PhaseNeedingASensorNothingCarriesIsAnError) {
+  const std::string y = doc(R"(
+uavs:
+  - {name: a, sees_lead: false}
+  - {name: b, sees_lead: false}
+phases:
+  - {name: first, from: 0, to: 100, config: 3}
+  - {name: second, from: 100, to: 210, config: 1}
+)");
+  EXPECT_EQ(error_of(y),
+            "scn.yaml:5: phases[0]: phase 'first' (configuration 3) needs lead_projection, but no UAV "
+            "carries it; switch it on (uavs[i].sees_lead: true) or add 'remove: [lead_projection]' "
+            "to the phase to run without it");
+  std::string removed = y;
+  removed.replace(removed.find("config: 3}"), 10, "config: 3, remove: [lead_projection]}");
+  removed.replace(removed.find("config: 1}"), 10, "config: 1, remove: [lead_projection]}");
+  EXPECT_NO_THROW(parse_scenarios(removed, "x.yaml"));
+  EXPECT_THAT(error_of("lead: {gps: false}\nphases:\n  - {from: 0, to: 210, config: 2}\n"),
+              HasSubstr("phase 'phase1' (configuration 2) needs gps, but the lead does not carry it"));
+  // The single-UAV baseline has only its own UAV's sensors.
+  EXPECT_THAT(error_of("uavs:\n  - {name: a, range: false}\n  - {name: b}\nestimator: {mode: single, "
+                       "single_uav: a}\nphases:\n  - {from: 0, to: 210, config: 2}\n"),
+              HasSubstr("needs range, but the single-UAV estimator's UAV 'a' does not carry it"));
+  // The integrated configuration feeds what is carried and needs nothing.
+  EXPECT_NO_THROW(parse_scenarios("lead: {gps: false}\n", "x.yaml"));
+}
+
+// The resolved configuration is a scenario of its own: read back, it resolves to itself.
+TEST(ScenarioYaml, ResolvedConfigurationReadsBackToItself) {
+  for (const auto& cfg : parse_scenarios(kFull, "dir/paper.yaml")) {
+    const std::string text = config_yaml(cfg);
+    const RunConfig back = parse_scenarios(text, "config.yaml").front();
+    std::string again = config_yaml(back);
+    // Only the comment naming the source differs.
+    EXPECT_EQ(text.substr(text.find('\n')), again.substr(again.find('\n'))) << cfg.variant;
+    EXPECT_EQ(back.estimator.mode, cfg.estimator.mode);
+    EXPECT_EQ(back.seed, cfg.seed);
+  }
+}
+
 }  // namespace
 }  // namespace wingman::app
