@@ -15,7 +15,7 @@
 
 #include "app/pipeline.hpp"
 #include "app/progress.hpp"
-#include "app/rendered_frontend.hpp"
+#include "app/vision_frontend.hpp"
 #include "app/replay.hpp"
 #include "eval/metrics.hpp"
 #include "vision/features.hpp"

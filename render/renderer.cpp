@@ -507,8 +507,8 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   const Eigen::Matrix4f P =
       to_float(projection(fx, fy, cx, cy, w, h, I.info.near, I.info.far, I.depth.reversed));
   Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
-  V.topLeftCorner<3, 3>() = view.R_CW;
-  V.topRightCorner<3, 1>() = -view.R_CW * view.x_c;
+  V.topLeftCorner<3, 3>() = view.pose.R_CW;
+  V.topRightCorner<3, 1>() = -view.pose.R_CW * view.pose.position;
   std::optional<Eigen::Matrix4d> lead_model;
   if (lead && !I.lead_meshes.empty()) {
     Eigen::Matrix4d M = Eigen::Matrix4d::Identity();

@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "geometry/camera.hpp"
+#include "geometry/pose.hpp"
 #include "render/gl_context.hpp"
 #include "render/scene.hpp"
 
@@ -24,8 +25,7 @@ namespace wingman::render {
 
 struct CameraView {
   geometry::PinholeCamera camera;
-  Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d x_c = Eigen::Vector3d::Zero();  // camera centre, world frame
+  geometry::CameraPose pose;
 };
 
 struct Frame {

@@ -12,9 +12,11 @@
 #include <optional>
 #include <vector>
 
+#include "geometry/pose.hpp"
+
 namespace wingman::slam {
 
-using LandmarkId = std::int64_t;
+using LandmarkId = geometry::LandmarkId;
 
 enum class LandmarkKind { Euclidean, InverseDepth };
 

@@ -5,6 +5,7 @@
 // landmarks each camera still needs; slam's initialise_from_matches takes their pixel pairs.
 #pragma once
 
+#include "geometry/pose.hpp"
 #include "geometry/settings.hpp"
 
 #include <Eigen/Core>
@@ -16,11 +17,7 @@
 namespace wingman::vision {
 
 // Camera pose as DESIGN.md §2 writes it: p_C = R_CW (p_W - position).
-struct CameraPose {
-  Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Vector3d to_camera(const Eigen::Vector3d& p_W) const { return R_CW * (p_W - position); }
-};
+using CameraPose = geometry::CameraPose;
 
 struct CameraView {
   geometry::PinholeCamera camera;

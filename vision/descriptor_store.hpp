@@ -9,9 +9,11 @@
 #include <unordered_map>
 #include <vector>
 
+#include "geometry/pose.hpp"
+
 namespace wingman::vision {
 
-using LandmarkId = std::int64_t;  // the same ids as slam's LandmarkId
+using LandmarkId = geometry::LandmarkId;
 
 class DescriptorStore {
  public:

@@ -2,7 +2,7 @@
 // initialisation.
 #include <gtest/gtest.h>
 
-#include "app/rendered_frontend.hpp"
+#include "app/vision_frontend.hpp"
 #include "app/run_config.hpp"
 
 namespace wingman::app {

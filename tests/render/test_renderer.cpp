@@ -64,14 +64,14 @@ TEST_P(RendererTest, PointLandsOnPinholePredictionAtCentreAndCorners) {
   for (const auto& uv : wanted) {
     const Eigen::Vector3d b = cam.bearing(uv);
     const Eigen::Vector3d p_C = b / b.z() * 20.0;  // on the ground plane z = 0
-    Eigen::Vector3d p_W = view.R_CW.transpose() * p_C + view.x_c;
+    Eigen::Vector3d p_W = view.pose.R_CW.transpose() * p_C + view.pose.position;
     p_W.z() = 0.01;  // just above the ground
     points.push_back(p_W);
   }
   Renderer r(ctx, target_scene(points, 0.6));
   const cv::Mat gray = r.render(view).gray();
   for (const auto& p : points) {
-    const auto uv = cam.project(view.R_CW * (p - view.x_c));
+    const auto uv = cam.project(view.pose.R_CW * (p - view.pose.position));
     ASSERT_TRUE(uv);
     const Eigen::Vector2d got = centroid(gray, *uv, 8);
     EXPECT_LT((got - *uv).norm(), 0.3) << "predicted " << uv->transpose() << " rendered "
@@ -87,8 +87,8 @@ TEST_P(RendererTest, DepthIsMetricAlongTheOpticalAxis) {
   Scene s = target_scene({}, 1);
   Renderer r(ctx, s);
   const Frame f = r.render(view);
-  const Eigen::Vector3d n_C = view.R_CW * Eigen::Vector3d::UnitZ();  // ground normal
-  const double d_C = n_C.dot(view.R_CW * (Eigen::Vector3d::Zero() - view.x_c));
+  const Eigen::Vector3d n_C = view.pose.R_CW * Eigen::Vector3d::UnitZ();  // ground normal
+  const double d_C = n_C.dot(view.pose.R_CW * (Eigen::Vector3d::Zero() - view.pose.position));
   double worst = 0;
   for (int v = 0; v < cam.height(); v += 7)
     for (int u = 0; u < cam.width(); u += 7) {
@@ -115,8 +115,8 @@ TEST_P(RendererTest, DepthIsAtThePixelCentreWithMsaaAndPreciseFarAway) {
       s.msaa = msaa;
       Renderer r(ctx, s);
       const Frame f = r.render(view);
-      const Eigen::Vector3d n_C = view.R_CW * Eigen::Vector3d::UnitZ();
-      const double d_C = n_C.dot(view.R_CW * (Eigen::Vector3d::Zero() - view.x_c));
+      const Eigen::Vector3d n_C = view.pose.R_CW * Eigen::Vector3d::UnitZ();
+      const double d_C = n_C.dot(view.pose.R_CW * (Eigen::Vector3d::Zero() - view.pose.position));
       double worst = 0;
       for (int v = 0; v < cam.height(); ++v)
         for (int u = 0; u < cam.width(); ++u) {
@@ -145,7 +145,7 @@ TEST_P(RendererTest, DistortionMovesPixelsAsTheCameraModelSays) {
   Renderer r(ctx, target_scene(points, 0.8));
   const cv::Mat gray = r.render(view).gray();
   for (const auto& p : points) {
-    const auto uv = cam.project(view.R_CW * (p - view.x_c));
+    const auto uv = cam.project(view.pose.R_CW * (p - view.pose.position));
     ASSERT_TRUE(uv && cam.in_image(*uv, 10));
     EXPECT_LT((centroid(gray, *uv, 8) - *uv).norm(), 0.5) << uv->transpose();
   }

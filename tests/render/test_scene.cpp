@@ -167,7 +167,7 @@ TEST_P(PaperSceneTest, LeadReferencePointIsWhereTheDepthSaysAndBothUavsSeeIt) {
       const CameraView view{scn.uavs[j].camera.camera(), truth.camera_R_CW(j, t),
                             truth.camera(j, t).position};
       const Frame f = r.render(view, lead);
-      const Eigen::Vector3d p_C = view.R_CW * (lead.position - view.x_c);
+      const Eigen::Vector3d p_C = view.pose.R_CW * (lead.position - view.pose.position);
       const auto uv = view.camera.project(p_C);
       ASSERT_TRUE(uv && view.camera.in_image(*uv, 20)) << "lead out of view of uav" << j + 1;
       const float d = f.depth.at<float>(static_cast<int>(std::lround(uv->y())),

@@ -1,0 +1,357 @@
+#include "app/loop.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <random>
+
+#include "app/timing.hpp"
+#include "app/version.hpp"
+#include "sim/rng.hpp"
+
+namespace wingman::app {
+
+namespace {
+
+// NEES (eq. 67) over the agents' positions and velocities.
+double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
+  const int d = s.kinematic_dim();
+  const Eigen::VectorXd e = truth - s.x.head(d);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(s.P.topLeftCorner(d, d));
+  if (ldlt.info() != Eigen::Success) return eval::kNaN;
+  return e.dot(ldlt.solve(e));
+}
+
+// NEES of one 3-vector block of the state against its marginal covariance.
+double block_nees(const slam::FilterState& s, int pos, const Eigen::Vector3d& truth) {
+  const Eigen::Vector3d e = truth - s.x.segment<3>(pos);
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(s.P.block<3, 3>(pos, pos));
+  if (ldlt.info() != Eigen::Success) return eval::kNaN;
+  return e.dot(ldlt.solve(e));
+}
+
+// The filter at t = 0: the truth, or the truth plus a draw of the initial covariance.
+slam::Estimator make_estimator(const RunConfig& cfg, const sim::Truth& truth, const std::vector<int>& cam_uav) {
+  std::mt19937_64 rng = sim::make_stream(cfg.seed, "initial_estimate");
+  std::normal_distribution<double> unit(0.0, 1.0);
+  const auto& sigma = cfg.estimator.initial_sigma;
+  auto initial = [&](const sim::KinematicState& k) {
+    slam::AgentInit a{k.position, k.velocity};
+    if (!sigma.draw) return a;
+    a.position += sim::gaussian3(rng, unit, sigma.position);
+    a.velocity += sim::gaussian3(rng, unit, sigma.velocity);
+    return a;
+  };
+  std::vector<slam::CameraRig> rigs;
+  std::vector<slam::AgentInit> cams;
+  for (int u : cam_uav) {
+    slam::CameraRig rig;
+    rig.model = cfg.uavs[u].camera.camera();
+    rig.R_CW = truth.commanded_R_CW();
+    rig.offset = cfg.uavs[u].camera.offset;
+    rig.orientation_sigma = cfg.estimator.measurement_noise.orientation_sigma;
+    rigs.push_back(rig);
+    cams.push_back(initial(truth.camera(u, 0.0)));
+  }
+  const slam::AgentInit lead = initial(truth.lead(0.0));
+  return slam::Estimator(rigs, lead, cams, cfg.estimator, cfg.seed);
+}
+
+eval::RunRecord make_record(const RunConfig& cfg, const std::vector<int>& cam_uav) {
+  eval::RunRecord rec;
+  rec.scenario_path = cfg.source_path;
+  rec.scenario_name = cfg.name;
+  rec.variant = cfg.variant;
+  rec.estimator_mode = slam::to_string(cfg.estimator.mode);
+  rec.seed = cfg.seed;
+  rec.software_version = kVersion;
+  rec.agent_names.push_back("lead");
+  for (int u : cam_uav) rec.agent_names.push_back(cfg.uavs[u].name);
+  for (const auto& p : cfg.phases) rec.phases.push_back({p.name, p.t_start, p.t_end, sim::to_string(p.config)});
+  for (int u : cam_uav) rec.outliers.push_back({cfg.uavs[u].name});
+  if (!cfg.single_uav()) rec.outliers.push_back({"cooperative"});
+  return rec;
+}
+
+struct StepCounts {
+  int visible = 0, offered = 0, accepted = 0, initialised = 0;
+};
+struct StepTimes {
+  double predict = 0, update = 0, init = 0, render = 0, detect = 0, match = 0;
+};
+
+// A run in progress: the filter, what the record keeps of it, and the step's per-camera state.
+class Run {
+ public:
+  Run(const RunConfig& cfg, const sim::Truth& truth, MeasurementSource& src)
+      : cfg_(cfg),
+        truth_(truth),
+        src_(src),
+        cam_uav_(cfg.filter_uavs()),
+        est(make_estimator(cfg, truth, cam_uav_)),
+        rec(make_record(cfg, cam_uav_)),
+        in_view_(cam_uav_.size(), 0),
+        sees_(cam_uav_.size(), false) {}
+
+  void update(double t, StepCounts& n, StepTimes& tm);
+  void initialise(double t, int phase, StepCounts& n, StepTimes& tm);
+  void end_step(double t);
+  void record_step(int k, double t, const StepCounts& n, const StepTimes& tm);
+  void snapshot_landmarks(int phase);
+  int cameras() const { return static_cast<int>(cam_uav_.size()); }
+  bool active(sim::Sensor s, double t, int cam) const {
+    return cfg_.sensor_active(s, t, cfg_.uavs[cam_uav_[cam]].name);
+  }
+
+ private:
+  void update_sensors(double t);
+  void add(slam::LandmarkId id, int cam, std::int64_t handle, const Eigen::Vector2d& uv, double t,
+           int phase, const char* origin, StepCounts& n);
+  void initialise_pairs(double t, int phase, std::vector<int>& added, StepCounts& n, StepTimes& tm);
+  void initialise_points(int cam, int need, double t, int phase, StepCounts& n, StepTimes& tm);
+
+  const RunConfig& cfg_;
+  const sim::Truth& truth_;
+  MeasurementSource& src_;
+  std::vector<int> cam_uav_;
+
+ public:
+  slam::Estimator est;
+  eval::RunRecord rec;
+
+ private:
+  std::map<slam::LandmarkId, std::size_t> lm_record_;  // filter id -> index in rec.landmarks
+  std::vector<int> in_view_;                            // this step's predictions, per camera
+  std::vector<bool> sees_;                              // landmarks switched on this step
+};
+
+// Landmark correspondences for what the filter predicts in view, with the lead's projections
+// of the same frames (eq. 5-6); then GPS, altimeter and range.
+void Run::update(double t, StepCounts& n, StepTimes& tm) {
+  const auto t0 = Clock::now();
+  std::vector<LandmarkObservation> obs;
+  for (int j = 0; j < cameras(); ++j) {
+    sees_[j] = active(sim::Sensor::Landmarks, t, j);
+    in_view_[j] = 0;
+    if (!sees_[j]) continue;
+    const auto preds = est.landmarks_in_view(j);
+    in_view_[j] = static_cast<int>(preds.size());
+    n.visible += in_view_[j];
+    const auto tm0 = Clock::now();
+    for (auto& o : src_.landmarks(j, preds)) obs.push_back(std::move(o));
+    tm.match += ms_since(tm0);
+  }
+  std::vector<slam::Correspondence> cands;
+  for (const auto& o : obs) cands.push_back(o.c);
+  std::vector<std::pair<int, Eigen::Vector2d>> lead_pixels;
+  for (int j = 0; j < cameras(); ++j)
+    if (active(sim::Sensor::LeadProjection, t, j))
+      if (auto uv = src_.lead_pixel(j)) lead_pixels.emplace_back(j, *uv);
+  const auto vr = est.update_visual(cands, lead_pixels);
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    auto& oc = rec.outliers[obs[i].c.cam];
+    ++oc.correspondences;
+    if (obs[i].injected) ++oc.injected;
+    if (obs[i].outlier) ++oc.outliers;
+    src_.verdict(obs[i], vr.accepted[i]);
+    if (!vr.accepted[i]) continue;
+    ++n.accepted;
+    ++oc.accepted;
+    if (obs[i].outlier) ++oc.outliers_accepted;
+  }
+  n.offered = static_cast<int>(cands.size());
+  update_sensors(t);
+  tm.update = ms_since(t0) - tm.match;
+}
+
+void Run::update_sensors(double t) {
+  slam::SensorBatch batch;
+  if (cfg_.sensor_active(sim::Sensor::Gps, t, "lead")) batch.gps = src_.gps();
+  for (int j = 0; j < cameras(); ++j) {
+    if (active(sim::Sensor::Altimeter, t, j))
+      if (auto a = src_.altimeter(j)) batch.altimeter.emplace_back(j, *a);
+    if (active(sim::Sensor::Range, t, j))
+      if (auto r = src_.range(j)) batch.range.emplace_back(j, *r);
+  }
+  est.update_sensors(batch);
+}
+
+// A new landmark's record for Table 5, with its truth when the source can tell it.
+void Run::add(slam::LandmarkId id, int cam, std::int64_t handle, const Eigen::Vector2d& uv, double t,
+              int phase, const char* origin, StepCounts& n) {
+  ++n.initialised;
+  const auto truth_point = src_.added(id, cam, handle, uv);
+  if (!truth_point) return;  // no rendered surface there: left out of Table 5
+  eval::LandmarkRecord lr;
+  lr.id = id;
+  lr.truth = *truth_point;
+  lr.t_init = t;
+  lr.init_phase = phase;
+  lr.est_init = lr.est_phase_end = lr.est_final = *est.landmark_position(id);
+  lr.origin = origin;
+  lm_record_[id] = rec.landmarks.size();
+  rec.landmarks.push_back(lr);
+}
+
+// New landmarks where a camera sees fewer than the target: cooperatively from pairs of cameras
+// (eq. 47-52), or from one camera's pixels in inverse depth (the single-UAV baseline, and multi-UAV
+// cameras the pairs left short when monocular_fill is on).
+void Run::initialise(double t, int phase, StepCounts& n, StepTimes& tm) {
+  const auto t0 = Clock::now();
+  const double match0 = tm.match;
+  const int target = cfg_.estimator.map.target_per_camera;
+  if (cfg_.single_uav()) {
+    if (sees_[0] && target - in_view_[0] > 0) initialise_points(0, target - in_view_[0], t, phase, n, tm);
+  } else {
+    std::vector<int> added(cameras(), 0);  // this step's cooperative landmarks, per camera
+    initialise_pairs(t, phase, added, n, tm);
+    for (int j = 0; j < cameras() && cfg_.estimator.initialisation.monocular_fill; ++j) {
+      const int need = target - in_view_[j] - added[j];
+      if (sees_[j] && need > 0) initialise_points(j, need, t, phase, n, tm);
+    }
+  }
+  tm.init = ms_since(t0) - (tm.match - match0);
+}
+
+// Each camera pairs with the next; a pair asks for the larger deficit of its two cameras.
+void Run::initialise_pairs(double t, int phase, std::vector<int>& added, StepCounts& n, StepTimes& tm) {
+  const int target = cfg_.estimator.map.target_per_camera;
+  std::map<std::pair<int, int>, int> pairs;
+  for (int j = 0; j < cameras(); ++j) {
+    const int o = (j + 1) % cameras();
+    const int need = target - in_view_[j];
+    if (o == j || need <= 0 || !sees_[j] || !sees_[o]) continue;
+    auto key = std::minmax(j, o);
+    pairs[key] = std::max(pairs[key], need);
+  }
+  eval::OutlierCounts& coop = rec.outliers.back();
+  for (const auto& [pr, need] : pairs) {
+    const auto tm0 = Clock::now();
+    const auto found = src_.pairs(pr.first, pr.second, need, est);
+    tm.match += ms_since(tm0);
+    std::vector<slam::CrossMatch> cm;
+    for (const auto& p : found) cm.push_back(p.m);
+    const auto outcomes = est.initialise_from_matches(cm);
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      ++coop.correspondences;
+      if (found[i].injected) ++coop.injected;
+      if (found[i].outlier) ++coop.outliers;
+      if (!outcomes[i].id) continue;
+      ++coop.accepted;
+      if (found[i].outlier) ++coop.outliers_accepted;
+      add(*outcomes[i].id, pr.first, found[i].handle, found[i].m.uv_a, t, phase, "cooperative", n);
+      ++added[pr.first], ++added[pr.second];
+    }
+  }
+}
+
+void Run::initialise_points(int cam, int need, double t, int phase, StepCounts& n, StepTimes& tm) {
+  const auto tm0 = Clock::now();
+  const auto points = src_.points(cam, need);
+  tm.match += ms_since(tm0);
+  for (const auto& p : points)
+    if (auto r = est.initialise_from_pixel(cam, p.uv); r.id)
+      add(*r.id, cam, p.handle, p.uv, t, phase, "inverse_depth", n);
+}
+
+// Map management; a removed landmark keeps its last estimate in the record.
+void Run::end_step(double t) {
+  for (slam::LandmarkId id : est.end_step()) {
+    src_.removed(id);
+    if (auto it = lm_record_.find(id); it != lm_record_.end()) rec.landmarks[it->second].t_removed = t;
+  }
+}
+
+// Latest estimate of every landmark in the map; a landmark removed later keeps its last one.
+void Run::snapshot_landmarks(int phase) {
+  for (const auto& slot : est.state().landmarks()) {
+    auto it = lm_record_.find(slot.id);
+    if (it == lm_record_.end()) continue;
+    auto& lr = rec.landmarks[it->second];
+    lr.est_final = est.state().landmark_position(slot);
+    if (phase == lr.init_phase) lr.est_phase_end = lr.est_final;
+  }
+}
+
+void Run::record_step(int k, double t, const StepCounts& n, const StepTimes& tm) {
+  eval::StepRecord st;
+  st.k = k;
+  st.t = t;
+  st.phase = cfg_.phase_at(t);
+  const auto& s = est.state();
+  Eigen::VectorXd x_true(s.kinematic_dim());
+  auto agent = [&](const sim::KinematicState& tr, int pos) {
+    eval::AgentStep a;
+    a.p_true = tr.position;
+    a.v_true = tr.velocity;
+    a.p_est = s.x.segment<3>(pos);
+    a.v_est = s.x.segment<3>(pos + 3);
+    a.p_sigma = s.P.block<3, 3>(pos, pos).diagonal().cwiseMax(0.0).cwiseSqrt();
+    if (k > 0) {
+      a.nees_p = block_nees(s, pos, tr.position);
+      a.nees_v = block_nees(s, pos + 3, tr.velocity);
+    }
+    x_true.segment<3>(pos) = tr.position;
+    x_true.segment<3>(pos + 3) = tr.velocity;
+    st.agents.push_back(a);
+  };
+  agent(truth_.lead(t), slam::FilterState::lead_pos());
+  for (int j = 0; j < cameras(); ++j) agent(truth_.camera(cam_uav_[j], t), slam::FilterState::cam_pos(j));
+  st.nees = k == 0 ? eval::kNaN : agent_nees(s, x_true);
+  st.nees_dof = s.kinematic_dim();
+  st.landmarks = est.num_landmarks();
+  st.landmarks_visible = n.visible;
+  st.matches_offered = n.offered;
+  st.matches_accepted = n.accepted;
+  st.initialised = n.initialised;
+  st.t_predict_ms = tm.predict;
+  st.t_update_ms = tm.update;
+  st.t_init_ms = tm.init;
+  st.t_render_ms = tm.render;
+  st.t_detect_ms = tm.detect;
+  st.t_match_ms = tm.match;
+  rec.steps.push_back(std::move(st));
+}
+
+}  // namespace
+
+eval::RunRecord run_loop(const RunConfig& cfg, const sim::Truth& truth, MeasurementSource& source,
+                         const LoopHooks& hooks, const ProgressFn& progress, const StateObserver& observer) {
+  const auto wall0 = Clock::now();
+  Run run(cfg, truth, source);
+  run.record_step(0, 0.0, {}, {});
+  if (hooks.control) hooks.control(0, 0.0, run.est, run.rec.steps.back());
+  const int N = cfg.num_steps();
+  for (int k = 1; k <= N; ++k) {
+    const double t = k * cfg.dt();
+    const int phase = cfg.phase_at(t);
+    if (hooks.advance) hooks.advance(k, t);
+    StepTimes tm;
+    StepCounts n;
+    auto t0 = Clock::now();
+    run.est.predict(cfg.dt());
+    tm.predict = ms_since(t0);
+    // The gimbal's commanded orientation is a known input (nadir).
+    for (int j = 0; j < run.cameras(); ++j) run.est.set_camera_rotation(j, truth.commanded_R_CW());
+    const StageTimes st = source.begin_step(k, t, run.est);
+    // Stage times add up to the step's wall time: detection is what it added beyond producing
+    // the frames (it overlaps the next camera's); its full duration is the source's to report.
+    tm.render = st.render_ms;
+    tm.detect = std::max(0.0, st.wall_ms - st.render_ms);
+    run.update(t, n, tm);
+    run.snapshot_landmarks(phase);
+    run.initialise(t, phase, n, tm);
+    run.end_step(t);
+    source.end_step(t);
+    run.record_step(k, t, n, tm);
+    if (hooks.control) hooks.control(k, t, run.est, run.rec.steps.back());
+    if (observer) observer(k, run.est.state());
+    if (progress) progress(k, N);
+  }
+  source.finish(run.rec);
+  run.rec.wall_time_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  return std::move(run.rec);
+}
+
+}  // namespace wingman::app
