@@ -111,7 +111,7 @@ int render_command(const RenderOptions& o) {
 
   render::Scene scene;
   try {
-    scene = render::build_scene(scn);
+    scene = render::build_scene(sim::describe_world(scn));
   } catch (const std::runtime_error& e) {
     throw UsageError(fmt::format("{}: world: {}", o.scenario, e.what()));
   }
@@ -164,7 +164,7 @@ int render_command(const RenderOptions& o) {
     }
     const double t = k * scn.dt();
     const std::int64_t t_ns = datasets::step_ns(k, scn.rate);
-    const render::LeadPose lead = render::lead_pose(scn, t);
+    const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
     const sim::KinematicState lk = truth.lead(t);
     // Ground truth heading: the path's, without the model's yaw_offset.
     const double heading = lead.yaw - scn.world.lead.yaw_offset;

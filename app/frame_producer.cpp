@@ -15,7 +15,7 @@ RendererFrames::RendererFrames(const RunConfig& cfg, std::vector<int> cam_uav, r
     : cfg_(cfg), cam_uav_(std::move(cam_uav)), truth_(truth) {
   render::Scene scene;
   try {
-    scene = render::build_scene(cfg);
+    scene = render::build_scene(sim::describe_world(cfg));
   } catch (const std::runtime_error& e) {  // a missing or broken asset: the scenario's fault
     throw std::invalid_argument(cfg.source_path + ": world: " + e.what());
   }
@@ -33,8 +33,7 @@ std::string RendererFrames::description() const { return ctx_->description(); }
 
 void RendererFrames::produce(int cam, int, double t, CameraFrame& out) {
   const int u = cam_uav_[cam];
-  render::LeadPose lead = render::lead_pose(cfg_, t);
-  lead.position = truth_.lead(t).position;
+  const render::LeadPose lead = sim::lead_pose(truth_, t, cfg_.world);
   out.true_pose = {truth_.camera_R_CW(u, t), truth_.camera(u, t).position};
   out.frame = renderer_->render({models_[cam], out.true_pose}, lead);
   effects_[cam]->apply(out.frame);

@@ -47,12 +47,12 @@ void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
     }
     return;
   }
-  render::Renderer renderer(*ctx, render::build_scene(scn));
+  render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
   const sim::OpenLoopTruth truth(scn);
   const double t = 20.0;
   const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t),
                                 truth.camera(0, t).position};
-  const render::LeadPose lead = render::lead_pose(scn, t);
+  const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
   renderer.render(view, lead);  // warm-up: framebuffers, shader compilation
   const double cpu0 = process_cpu_seconds();
   for (auto _ : state) {

@@ -16,7 +16,6 @@
 #include <stdexcept>
 
 #include "sim/rng.hpp"
-#include "sim/truth.hpp"
 
 #ifndef WINGMAN_ASSETS_DIR
 #define WINGMAN_ASSETS_DIR "assets"
@@ -135,9 +134,9 @@ cv::Mat detail_texture(std::uint64_t seed) {
   return rgb;
 }
 
-Mesh terrain_mesh(const sim::Scenario& scn, const sim::TerrainModel& terrain, int material,
+Mesh terrain_mesh(const sim::WorldSpec& world, const sim::TerrainModel& terrain, int material,
                   double tex_w, double tex_h) {
-  const auto& spec = scn.world.terrain;
+  const auto& spec = world.terrain;
   const Eigen::Vector4d& b = terrain.bounds();
   const int nx = static_cast<int>(std::lround((b(2) - b(0)) / spec.resolution)) + 1;
   const int ny = static_cast<int>(std::lround((b(3) - b(1)) / spec.resolution)) + 1;
@@ -145,8 +144,8 @@ Mesh terrain_mesh(const sim::Scenario& scn, const sim::TerrainModel& terrain, in
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i)
       h[j * nx + i] = terrain.height(b(0) + i * spec.resolution, b(1) + j * spec.resolution);
-  const bool stretched = scn.world.texture.mode == sim::TextureSpec::Mode::Stretched &&
-                         scn.world.texture.type == sim::TextureSpec::Type::Image;
+  const bool stretched = world.texture.mode == sim::TextureSpec::Mode::Stretched &&
+                         world.texture.type == sim::TextureSpec::Type::Image;
   Mesh m;
   m.material = material;
   for (int j = 0; j < ny; ++j) {
@@ -429,20 +428,8 @@ void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, co
   scene.lead_meshes.push_back(std::move(q));
 }
 
-LeadPose lead_pose(const sim::Scenario& scn, double t) {
-  const sim::OpenLoopTruth truth(scn);
-  const sim::KinematicState k = truth.lead(t);
-  LeadPose p;
-  p.position = k.position;
-  // The heading of the path; at a standstill (zero speed) keep the heading of t + 0.1 s.
-  Eigen::Vector3d v = k.velocity;
-  if (v.head<2>().norm() < 1e-6) v = truth.lead(t + 0.1).position - k.position;
-  p.yaw = std::atan2(v.y(), v.x()) + scn.world.lead.yaw_offset;
-  return p;
-}
-
-Scene build_scene(const sim::Scenario& scn) {
-  const sim::WorldSpec& w = scn.world;
+Scene build_scene(const sim::WorldDescription& world) {
+  const sim::WorldSpec& w = world.spec;
   Scene scene;
   scene.light = w.light;
   scene.sky = w.image.sky;
@@ -450,37 +437,34 @@ Scene build_scene(const sim::Scenario& scn) {
   scene.far = w.far;
   scene.msaa = w.image.msaa;
 
-  const sim::OpenLoopTruth truth(scn);
-  const sim::TerrainModel terrain(scn, truth);
-
   Material ground;
   ground.anisotropy = w.texture.anisotropy;
   ground.trilinear = w.texture.filter == sim::TextureSpec::Filter::Trilinear;
   double tex_w = w.texture.tile_size, tex_h = w.texture.tile_size;
   if (w.texture.type == sim::TextureSpec::Type::Image) {
-    const std::string p = resolve_asset(w.texture.image, scn.source_path, "ground texture");
+    const std::string p = resolve_asset(w.texture.image, world.scenario_path, "ground texture");
     ground.texture = read_image_rgb(p, "ground texture");
     ground.repeat = w.texture.mode == sim::TextureSpec::Mode::Tiled;
     // Keep the image's aspect ratio: tile_size is its width.
     tex_h = tex_w * ground.texture.rows / ground.texture.cols;
   } else {
-    ground.texture = procedural_ground(w.texture, scn.seed);
+    ground.texture = procedural_ground(w.texture, world.seed);
     tex_w = tex_h = w.texture.size * w.texture.detail_min;
   }
   scene.materials.push_back(ground);
-  scene.static_meshes.push_back(terrain_mesh(scn, terrain, 0, tex_w, tex_h));
+  scene.static_meshes.push_back(terrain_mesh(w, world.terrain, 0, tex_w, tex_h));
 
-  const auto objects = sim::scatter_objects(scn, terrain);
+  const auto& objects = world.objects;
   if (!objects.empty()) {
     Material detail;
-    detail.texture = detail_texture(scn.seed);
+    detail.texture = detail_texture(world.seed);
     detail.anisotropy = w.texture.anisotropy;
     detail.trilinear = ground.trilinear;
     scene.materials.push_back(detail);
     scene.static_meshes.push_back(
         objects_mesh(objects, static_cast<int>(scene.materials.size()) - 1));
   }
-  load_lead_model(w.lead, resolve_asset(w.lead.model, scn.source_path, "lead model"), ground, scene);
+  load_lead_model(w.lead, resolve_asset(w.lead.model, world.scenario_path, "lead model"), ground, scene);
   return scene;
 }
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/scenario.hpp"
+#include "sim/world.hpp"
 
 namespace wingman::render {
 
@@ -49,10 +49,7 @@ struct Scene {
 };
 
 // Pose of the lead's reference point: position in the world and heading about world z.
-struct LeadPose {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  double yaw = 0;
-};
+using LeadPose = sim::LeadPose;
 
 // A relative asset path against the scenario file's directory, then the repository's assets/.
 // Absolute paths are used as they are. Throws std::runtime_error naming every place looked at.
@@ -66,10 +63,7 @@ std::string resolve_asset(const std::string& path, const std::string& scenario_p
 void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, const Material& sampling,
                      Scene& scene);
 
-// The whole world of a scenario.
-Scene build_scene(const sim::Scenario& scn);
-
-// The lead's pose at t (heading from its velocity).
-LeadPose lead_pose(const sim::Scenario& scn, double t);
+// The whole world a scenario describes (sim::describe_world).
+Scene build_scene(const sim::WorldDescription& world);
 
 }  // namespace wingman::render

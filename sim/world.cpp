@@ -147,4 +147,21 @@ std::vector<WorldObject> scatter_objects(const Scenario& scn, const TerrainModel
   return out;
 }
 
+WorldDescription describe_world(const Scenario& scn) {
+  const OpenLoopTruth truth(scn);
+  TerrainModel terrain(scn, truth);
+  auto objects = scatter_objects(scn, terrain);
+  return {scn.world, std::move(terrain), std::move(objects), scn.source_path, scn.seed};
+}
+
+LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world) {
+  const KinematicState k = truth.lead(t);
+  LeadPose p;
+  p.position = k.position;
+  Eigen::Vector3d v = k.velocity;
+  if (v.head<2>().norm() < 1e-6) v = truth.lead(t + 0.1).position - k.position;
+  p.yaw = std::atan2(v.y(), v.x()) + world.lead.yaw_offset;
+  return p;
+}
+
 }  // namespace wingman::sim

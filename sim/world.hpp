@@ -15,6 +15,7 @@ namespace wingman::sim {
 
 struct Scenario;
 class OpenLoopTruth;
+class Truth;
 
 struct TerrainSpec {
   double extent = 0;          // m, side of the square terrain; 0: the flight's extent plus margin
@@ -213,5 +214,25 @@ inline constexpr double kLeadCueLift = 0.01;
 // Height of the lead's reference point (the centre of its roof cue) above its ground contact:
 // the model's height plus kLeadCueLift.
 double lead_reference_height(const WorldSpec& w);
+
+// Everything the renderer draws, resolved from a scenario: the world's spec, its terrain and the
+// objects placed on it (along the open-loop flight), where relative asset paths start, and the
+// seed of the procedural textures. render/ receives this, never the scenario or its truth.
+struct WorldDescription {
+  WorldSpec spec;
+  TerrainModel terrain;
+  std::vector<WorldObject> objects;
+  std::string scenario_path;  // relative asset paths start next to it
+  std::uint64_t seed = 1;
+};
+WorldDescription describe_world(const Scenario& scn);
+
+// The lead's reference point and heading about world z at t: the model faces its direction of
+// travel (the heading of t + 0.1 s at a standstill), turned by the world's yaw_offset.
+struct LeadPose {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double yaw = 0;
+};
+LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world);
 
 }  // namespace wingman::sim

@@ -20,6 +20,10 @@ IGNORED_KEYS = {"wall_time_s", "timings_ms", "software_version", "scenario_path"
                 "real_time_factor", "renderer", "path"}
 
 
+def is_ignored_key(key):
+    return key in IGNORED_KEYS or key.endswith("_ms") or key.endswith("_ms_per_step")
+
+
 def is_timing_column(name):
     return name.startswith("t_") and name.endswith("_ms")
 
@@ -44,7 +48,7 @@ def compare_csv(a, b):
 def compare_json(x, y, path=""):
     if isinstance(x, dict) and isinstance(y, dict):
         for k in sorted(set(x) | set(y)):
-            if k in IGNORED_KEYS:
+            if is_ignored_key(k):
                 continue
             if k not in x or k not in y:
                 return f"{path}.{k}: only in {'B' if k not in x else 'A'}"

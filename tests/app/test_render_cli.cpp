@@ -62,11 +62,11 @@ TEST(RenderCli, WritesADatasetThatReadsBackAndMatchesADirectRender) {
   app::RunConfig s = app::load_run_configs(scn.string()).front();
   s.seed = 5;
   const sim::OpenLoopTruth truth(s);
-  render::Renderer renderer(*ctx, render::build_scene(s));
+  render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(s)));
   const double t = 0.1;
   const render::Frame f = renderer.render(
       {s.uavs[1].camera.camera(), truth.camera_R_CW(1, t), truth.camera(1, t).position},
-      render::lead_pose(s, t));
+      sim::lead_pose(truth, t, s.world));
   EXPECT_EQ(cv::norm(ds.load_image("uav2", 100000000), f.rgb, cv::NORM_INF), 0);
   EXPECT_LT((ds.agent("uav2").camera_pose[1].p - truth.camera(1, t).position).norm(), 1e-6);
 }

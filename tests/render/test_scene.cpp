@@ -44,7 +44,7 @@ struct TempDir {
 
 TEST(Scene, LeadIsScaledToItsHeightAndSpansThirtyPixelsFromFifteenMetres) {
   const sim::Scenario scn = sim::load_scenarios(kPaper).front();
-  const Scene s = build_scene(scn);
+  const Scene s = build_scene(sim::describe_world(scn));
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
   for (const auto& m : s.lead_meshes)
     for (std::size_t i = 0; i < m.vertex_count(); ++i) {
@@ -65,7 +65,7 @@ TEST(Scene, EveryMaterialTakesTheWorldsTextureSampling) {
   sim::Scenario scn = sim::load_scenarios(kPaper).front();
   scn.world.texture.anisotropy = 1;
   scn.world.texture.filter = sim::TextureSpec::Filter::Bilinear;
-  const Scene s = build_scene(scn);
+  const Scene s = build_scene(sim::describe_world(scn));
   ASSERT_GE(s.materials.size(), 4u);  // ground, objects, the truck's textures, the cue
   int lead_textured = 0;
   for (const auto& m : s.lead_meshes) lead_textured += m.material >= 0;
@@ -76,7 +76,7 @@ TEST(Scene, EveryMaterialTakesTheWorldsTextureSampling) {
   }
   scn.world.texture.anisotropy = 8;
   scn.world.texture.filter = sim::TextureSpec::Filter::Trilinear;
-  for (const auto& m : build_scene(scn).materials) {
+  for (const auto& m : build_scene(sim::describe_world(scn)).materials) {
     EXPECT_EQ(m.anisotropy, 8.0);
     EXPECT_TRUE(m.trilinear);
   }
@@ -106,7 +106,7 @@ TEST(Scene, MissingModelNonModelAndMissingTextureAreErrorsNamingTheFile) {
   sim::Scenario scn = paper();
   scn.world.texture.image = "no_such_aerial.jpg";
   try {
-    build_scene(scn);
+    build_scene(sim::describe_world(scn));
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("no_such_aerial.jpg"), std::string::npos) << e.what();
@@ -130,7 +130,7 @@ TEST(Scene, ProceduralTextureIsSeeded) {
   a.world.texture.size = 256;
   sim::Scenario b = a;
   b.seed = a.seed + 1;
-  const Scene sa = build_scene(a), sa2 = build_scene(a), sb = build_scene(b);
+  const Scene sa = build_scene(sim::describe_world(a)), sa2 = build_scene(sim::describe_world(a)), sb = build_scene(sim::describe_world(b));
   EXPECT_EQ(cv::norm(sa.materials[0].texture, sa2.materials[0].texture, cv::NORM_INF), 0);
   EXPECT_GT(cv::norm(sa.materials[0].texture, sb.materials[0].texture, cv::NORM_INF), 0);
 }
@@ -145,12 +145,12 @@ TEST_P(PaperSceneTest, SameScenarioAndSeedGiveIdenticalImages) {
   const CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t), truth.camera(0, t).position};
   Frame first, second;
   {
-    Renderer r(ctx, build_scene(scn));
-    first = r.render(view, lead_pose(scn, t));
+    Renderer r(ctx, build_scene(sim::describe_world(scn)));
+    first = r.render(view, sim::lead_pose(truth, t, scn.world));
   }
   {
-    Renderer r(ctx, build_scene(scn));
-    second = r.render(view, lead_pose(scn, t));
+    Renderer r(ctx, build_scene(sim::describe_world(scn)));
+    second = r.render(view, sim::lead_pose(truth, t, scn.world));
   }
   EXPECT_EQ(cv::norm(first.rgb, second.rgb, cv::NORM_INF), 0);
   EXPECT_EQ(cv::norm(first.depth, second.depth, cv::NORM_INF), 0);
@@ -160,9 +160,9 @@ TEST_P(PaperSceneTest, LeadReferencePointIsWhereTheDepthSaysAndBothUavsSeeIt) {
   WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
   const sim::Scenario scn = paper(400);
   const sim::OpenLoopTruth truth(scn);
-  Renderer r(ctx, build_scene(scn));
+  Renderer r(ctx, build_scene(sim::describe_world(scn)));
   for (double t : {0.0, 30.0}) {
-    const LeadPose lead = lead_pose(scn, t);
+    const LeadPose lead = sim::lead_pose(truth, t, scn.world);
     for (int j = 0; j < 2; ++j) {
       const CameraView view{scn.uavs[j].camera.camera(), truth.camera_R_CW(j, t),
                             truth.camera(j, t).position};
