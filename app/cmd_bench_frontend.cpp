@@ -3,6 +3,7 @@
 // frame, the fraction of them correct against the ground-truth labels, cooperative pairs and
 // landmarks initialised. The estimator is in the loop because what it predicts is what tracking
 // searches for; the lead detector and everything else stay as in `wingman slam`.
+#include "app/cli_options.hpp"
 #include "app/subcommand.hpp"
 
 #include <CLI/CLI.hpp>
@@ -26,13 +27,14 @@ namespace {
 
 struct BenchOptions {
   std::string dataset;
-  std::string variant;
+  std::vector<std::string> variants;
+  StepLimit limit;
   std::vector<std::string> detectors{"orb", "gftt_orb", "akaze", "sift"};
   int max_features = 0;  // 0: the scenario's frontend.max_features
   bool quiet = false;
 };
 
-int bench_command(const BenchOptions& o) {
+int bench_command(const BenchOptions& o, const std::string& variant) {
   for (const auto& name : o.detectors) {  // a typo is a usage error, before any loading
     try {
       vision::parse_detector(name);
@@ -40,7 +42,8 @@ int bench_command(const BenchOptions& o) {
       throw UsageError(e.what());
     }
   }
-  const Replay replay = load_replay(o.dataset, o.variant);
+  Replay replay = load_replay(o.dataset, variant);
+  apply_step_limit(o.limit, replay.scenario);
   const RunConfig& scn = replay.scenario;
   // Each detector with the rest of the scenario's frontend section (bucketing, thresholds).
   std::vector<vision::FeatureSettings> settings;
@@ -113,14 +116,17 @@ Subcommand add_bench_frontend(CLI::App& parent) {
       "bench-frontend", "Replay a rendered dataset once per feature detector and compare them: ms "
                         "per frame, matches per frame, fraction correct, landmarks initialised");
   cmd->add_option("dataset", o->dataset, "Dataset directory (from wingman render)")->required();
-  cmd->add_option("--variant", o->variant, "Estimator settings of this variant (default: the dataset's)");
+  add_variant_option(cmd, o->variants, "Estimator settings of this variant (default: the dataset's)");
+  add_step_limit(cmd, o->limit);
   cmd->add_option("--detector", o->detectors, "Detectors to compare (repeatable; default: all four)")
       ->check(CLI::IsMember({"orb", "gftt_orb", "akaze", "sift"}));
   cmd->add_option("--max-features", o->max_features,
                   "Features per frame (default: the scenario's frontend.max_features)")
       ->check(CLI::Range(10, 100000));
   cmd->add_flag("--quiet,-q", o->quiet, "No progress lines");
-  return {cmd, [o] { return bench_command(*o); }};
+  return {cmd, [o] {
+            return for_each_variant(o->variants, [&](const std::string& v) { return bench_command(*o, v); });
+          }};
 }
 
 }  // namespace wingman::app

@@ -27,6 +27,7 @@
 
 #include "app/progress.hpp"
 #include "app/subcommand.hpp"
+#include "app/cli_options.hpp"
 #include "app/variants.hpp"
 #include "eval/montecarlo.hpp"
 #include "eval/paired.hpp"
@@ -50,6 +51,7 @@ struct MonteCarloOptions {
   std::string out;
   std::uint64_t first_seed = 1;
   std::vector<std::string> variants;
+  StepLimit limit;
   bool resume = false;
   int batch = 0;
   bool no_plots = false;
@@ -76,6 +78,8 @@ pid_t spawn_worker(const MonteCarloOptions& o, std::uint64_t seed, const fs::pat
   std::vector<std::string> args = {"wingman",  "run",   o.scenario, "--seed", std::to_string(seed),
                                    "--out",    run_dir(out, seed).string(), "--no-plots", "-q"};
   for (const auto& v : o.variants) args.insert(args.end(), {"--variant", v});
+  if (o.limit.duration) args.insert(args.end(), {"--duration", fmt::format("{}", *o.limit.duration)});
+  if (o.limit.frames) args.insert(args.end(), {"--frames", std::to_string(*o.limit.frames)});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -113,6 +117,7 @@ int montecarlo_command(const MonteCarloOptions& o) {
     throw UsageError(fmt::format("--batch {}: a batch needs 2 to --runs ({}) runs", o.batch, o.runs));
   // Bad input fails here, before any work.
   const auto scenarios = select_variants(load_run_configs(o.scenario), o.variants, o.scenario);
+  o.limit.seconds(scenarios.front().rate);  // a bad --duration or --frames fails here, not per worker
   if (!o.no_plots && !eval::gnuplot_available())
     throw UsageError("gnuplot with the pngcairo terminal was not found; install it (setup.sh does) "
                      "or pass --no-plots");
@@ -267,7 +272,8 @@ Subcommand add_montecarlo(CLI::App& parent) {
   cmd->add_option("--jobs,-j", o->jobs, "Worker processes (default: one per core)");
   cmd->add_option("--out,-o", o->out, "Output directory (default: results/<scenario name>_montecarlo)");
   cmd->add_option("--first-seed", o->first_seed, "Seed of the first run (default 1)");
-  cmd->add_option("--variant", o->variants, "Run only these variants (repeatable)");
+  add_variant_option(cmd, o->variants, "Run only this variant");
+  add_step_limit(cmd, o->limit);
   cmd->add_option("--batch", o->batch,
                   "Also split the runs (by seed) into batches of this many and apply the per-step "
                   "bounds test to each, with how often an exactly consistent filter passes it");

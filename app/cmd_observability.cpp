@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "app/cli_options.hpp"
 #include "app/run_config.hpp"
 #include "sim/synthetic_source.hpp"
 #include "sim/truth.hpp"
@@ -35,7 +36,8 @@ struct ObsOptions {
   unsigned long seed = 1;
   double tol = 1e-8;
   double state_tol = 1e-6;
-  std::string scenario, variant;
+  std::string scenario;
+  std::vector<std::string> variants;
   double at = 0;
   CLI::Option* at_opt = nullptr;
   bool json = false;
@@ -208,14 +210,14 @@ slam::EvaluationPoint scenario_point(const RunConfig& scn, double t, int n1) {
 
 std::string fmt_num(double v) { return std::fabs(v) < 5e-5 ? "0" : fmt::format("{:.4f}", v); }
 
-int observability_command(const ObsOptions& o) {
+int observability_command(const ObsOptions& o, const std::string& variant) {
   if (o.landmarks < 0) throw UsageError("--landmarks: must be >= 0");
   if (o.order < 0 || o.order > slam::kMaxLieOrder)
     throw UsageError(fmt::format("--order: must be in 0..{}", slam::kMaxLieOrder));
   if (!(o.tol > 0 && o.tol < 1)) throw UsageError("--tol: must be in (0, 1)");
   if (!(o.state_tol > 0 && o.state_tol < 1)) throw UsageError("--state-tol: must be in (0, 1)");
   if (o.config && (*o.config < 1 || *o.config > 3)) throw UsageError("--config: must be 1, 2 or 3");
-  if (o.scenario.empty() && (o.at_opt->count() > 0 || !o.variant.empty()))
+  if (o.scenario.empty() && (o.at_opt->count() > 0 || !variant.empty()))
     throw UsageError("--at and --variant need --scenario");
 
   // Where to evaluate, and the sensor set to start from.
@@ -226,9 +228,9 @@ int observability_command(const ObsOptions& o) {
   if (!o.scenario.empty()) {
     auto scenarios = load_run_configs(o.scenario);
     auto it = std::find_if(scenarios.begin(), scenarios.end(), [&](const RunConfig& s) {
-      return o.variant.empty() || s.variant == o.variant;
+      return variant.empty() || s.variant == variant;
     });
-    if (it == scenarios.end()) throw UsageError(fmt::format("{}: no variant '{}'", o.scenario, o.variant));
+    if (it == scenarios.end()) throw UsageError(fmt::format("{}: no variant '{}'", o.scenario, variant));
     const RunConfig& scn = *it;
     if (!(o.at >= 0 && o.at <= scn.duration))
       throw UsageError(fmt::format("--at: {} outside the scenario's [0, {}] s", o.at, scn.duration));
@@ -359,10 +361,12 @@ Subcommand add_observability(CLI::App& parent) {
                   "A state is observable when its unit vector's projection on the null space is below this (default 1e-6)");
   cmd->add_option("--scenario", o->scenario, "Evaluate at the true state of this scenario's trajectory")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--variant", o->variant, "Scenario variant (default: the first)");
+  add_variant_option(cmd, o->variants, "Scenario variant (default: the first)");
   o->at_opt = cmd->add_option("--at", o->at, "Time on the scenario's trajectory, s (default 0)");
   cmd->add_flag("--json", o->json, "Print JSON (dim, rank, unobservable_modes, null_space, observable, ...)");
-  return {cmd, [o] { return observability_command(*o); }};
+  return {cmd, [o] {
+            return for_each_variant(o->variants, [&](const std::string& v) { return observability_command(*o, v); });
+          }};
 }
 
 }  // namespace wingman::app

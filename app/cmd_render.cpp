@@ -2,6 +2,7 @@
 // image dataset with depth, sensor samples and ground truth (datasets/dataset.hpp). The dataset
 // is staged next to --out and renamed into place only when complete, so a failed or interrupted
 // run (Ctrl-C included) never leaves a directory that looks finished.
+#include "app/cli_options.hpp"
 #include "app/subcommand.hpp"
 #include "app/variants.hpp"
 
@@ -63,15 +64,14 @@ struct RenderOptions {
   std::string out;
   std::string gl = "auto";
   std::optional<std::uint64_t> seed;
-  std::string variant;
-  std::optional<int> frames;
-  std::optional<double> duration;
+  std::vector<std::string> variants;
+  StepLimit limit;
   bool gray = false;
   bool quiet = false;
 };
 
-RunConfig pick(const RenderOptions& o) {
-  RunConfig scn = select_variant(load_run_configs(o.scenario), o.variant, o.scenario);
+RunConfig pick(const RenderOptions& o, const std::string& variant) {
+  RunConfig scn = select_variant(load_run_configs(o.scenario), variant, o.scenario);
   if (o.seed) scn.seed = *o.seed;
   return scn;
 }
@@ -80,14 +80,13 @@ RunConfig pick(const RenderOptions& o) {
 // is always built for the whole run, so a short preview shows exactly the full run's first frames.
 int steps_to_render(const RenderOptions& o, const RunConfig& scn) {
   int n = scn.num_steps();
-  if (o.frames && o.duration) throw UsageError("--frames and --duration exclude each other");
-  if (o.frames) {
-    if (*o.frames < 1) throw UsageError("--frames must be at least 1");
-    n = std::min(n, *o.frames - 1);
+  if (o.limit.frames) {
+    if (*o.limit.frames < 1) throw UsageError("--frames must be at least 1");
+    n = std::min(n, *o.limit.frames - 1);
   }
-  if (o.duration) {
-    if (!(*o.duration >= 0)) throw UsageError("--duration must be >= 0");
-    n = std::min(n, static_cast<int>(std::floor(*o.duration * scn.rate + 1e-9)));
+  if (o.limit.duration) {
+    if (!(*o.limit.duration >= 0)) throw UsageError("--duration must be >= 0");
+    n = std::min(n, static_cast<int>(std::floor(*o.limit.duration * scn.rate + 1e-9)));
   }
   return n;
 }
@@ -97,17 +96,19 @@ datasets::PoseSample pose(std::int64_t t, const Eigen::Vector3d& p, const Eigen:
   return {t, p, geometry::quaternion_xyzw(R), v};
 }
 
-int render_command(const RenderOptions& o) {
+// One variant's dataset into `out` (or, with several variants, out/<variant>).
+int render_command(const RenderOptions& o, const std::string& variant) {
   render::GlBackend backend;
   try {
     backend = render::gl_backend_from_string(o.gl);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  const RunConfig scn = pick(o);
+  const RunConfig scn = pick(o, variant);
   const int n = steps_to_render(o, scn);
   InterruptGuard guard;  // from here on Ctrl-C is noticed at the next step and cleans up
-  const fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);
+  fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);
+  if (o.variants.size() > 1) out /= scn.variant;
 
   render::Scene scene;
   try {
@@ -212,12 +213,15 @@ Subcommand add_render(CLI::App& parent) {
   cmd->add_option("--gl", o->gl, "OpenGL backend: auto (EGL, then OSMesa), egl or osmesa")
       ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
   cmd->add_option("--seed", o->seed, "Override the scenario's seed");
-  cmd->add_option("--variant", o->variant, "Which variant's settings to use (default: the first)");
-  cmd->add_option("--frames", o->frames, "Render only the first N steps");
-  cmd->add_option("--duration", o->duration, "Render only the first S seconds");
+  add_variant_option(cmd, o->variants,
+                     "Which variant's settings to use (default: the first; with several, one dataset "
+                     "each, OUT/<variant>)");
+  add_step_limit(cmd, o->limit);
   cmd->add_flag("--gray", o->gray, "Write 8-bit gray frames instead of RGB");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
-  return {cmd, [o] { return render_command(*o); }};
+  return {cmd, [o] {
+            return for_each_variant(o->variants, [&](const std::string& v) { return render_command(*o, v); });
+          }};
 }
 
 }  // namespace wingman::app

@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "app/cli_options.hpp"
 #include "app/pipeline.hpp"
 #include "app/progress.hpp"
 #include "app/version.hpp"
@@ -38,7 +39,7 @@ struct RunOptions {
   bool correspondences = false;
   bool quiet = false;
   bool print_config = false;
-  std::optional<double> duration;
+  StepLimit limit;
 };
 
 int run_command(const RunOptions& o) {
@@ -51,7 +52,7 @@ int run_command(const RunOptions& o) {
   auto scenarios = select_variants(load_run_configs(o.scenario), o.variants, o.scenario);
   for (auto& s : scenarios) {
     if (o.seed) s.seed = *o.seed;
-    if (o.duration) limit_duration(s, *o.duration);
+    apply_step_limit(o.limit, s);
   }
   if (o.print_config) {
     for (const auto& s : scenarios) fmt::print("{}", config_yaml(s));
@@ -133,20 +134,19 @@ Subcommand add_run(CLI::App& parent) {
   cmd->add_option("scenario", o->scenario, "Scenario YAML file")->required();
   cmd->add_option("--out,-o", o->out, "Results directory (default: results/<scenario name>)");
   cmd->add_option("--seed", o->seed, "Override the scenario's seed");
-  cmd->add_option("--duration", o->duration,
-                  "Run only the first this many seconds (phases and outages cut there)")
-      ->check(CLI::PositiveNumber);
+  add_step_limit(cmd, o->limit);
   cmd->add_flag("--print-config", o->print_config,
                 "Print each variant's resolved configuration (every key, defaults included) as "
                 "YAML and exit; every results directory keeps it as config.yaml");
-  cmd->add_option("--variant", o->variants, "Run only these variants (repeatable)");
+  add_variant_option(cmd, o->variants, "Run only this variant");
   cmd->add_option("--gl", o->gl,
                   "OpenGL backend for rendered scenarios: auto (EGL, then OSMesa), egl or osmesa")
       ->check(CLI::IsMember({"auto", "egl", "osmesa"}));
   cmd->add_option("--video", o->video,
-                  "Rendered scenarios: write both cameras side by side with tracked landmarks, "
-                  "new matches, rejected correspondences and the lead detection (MJPG AVI; one "
-                  "file per variant, FILE_<variant>.avi, when several run)");
+                  "Rendered scenarios: write every camera in the filter side by side at half size, "
+                  "with the tracked landmarks (red; green once the filter accepted them, so red "
+                  "alone is a rejected one), new landmarks' pixels (yellow) and the lead detection "
+                  "(magenta); MJPG AVI, one file per variant, FILE_<variant>.avi, when several run");
   cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
   cmd->add_flag("--no-prefetch", o->no_prefetch,
                 "Rendered, open loop: render each step's frames at that step, not during the "

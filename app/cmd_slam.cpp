@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 
+#include "app/cli_options.hpp"
 #include "app/pipeline.hpp"
 #include "app/progress.hpp"
 #include "app/replay.hpp"
@@ -31,21 +32,25 @@ namespace {
 struct SlamOptions {
   std::string dataset;
   std::string out;
-  std::string variant;
+  std::vector<std::string> variants;
+  StepLimit limit;
   bool no_plots = false;
   bool correspondences = false;
   bool quiet = false;
 };
 
-int slam_command(const SlamOptions& o) {
-  const Replay replay = load_replay(o.dataset, o.variant);
+// One variant's replay into `out` (or, with several variants, out/<variant>).
+int slam_command(const SlamOptions& o, const std::string& variant) {
+  Replay replay = load_replay(o.dataset, variant);
+  apply_step_limit(o.limit, replay.scenario);
   const datasets::Dataset& ds = replay.dataset;
   const RunConfig& scn = replay.scenario;
   const fs::path& scn_path = replay.scenario_path;
   if (!o.no_plots && !eval::gnuplot_available())
     throw UsageError("gnuplot with the pngcairo terminal was not found; install it or pass --no-plots");
 
-  const fs::path out = o.out.empty() ? fs::path("results") / (scn.name + "_replay") : fs::path(o.out);
+  fs::path out = o.out.empty() ? fs::path("results") / (scn.name + "_replay") : fs::path(o.out);
+  if (o.variants.size() > 1) out /= scn.variant;
   std::optional<eval::ResultsDir> staged;
   try {
     staged.emplace(out);
@@ -79,15 +84,17 @@ Subcommand add_slam(CLI::App& parent) {
               "estimator, into a results directory (the same metrics as `wingman run`)");
   cmd->add_option("dataset", o->dataset, "Dataset directory")->required();
   cmd->add_option("--out,-o", o->out, "Results directory (default: results/<scenario>_replay)");
-  cmd->add_option("--variant", o->variant,
-                  "Estimator settings of this variant of the dataset's scenario (default: the "
-                  "variant it was rendered with, else the first)");
+  add_variant_option(cmd, o->variants,
+                     "Estimator settings of this variant of the dataset's scenario (default: the "
+                     "variant it was rendered with, else the first; with several, one results "
+                     "directory each, OUT/<variant>)");
+  add_step_limit(cmd, o->limit);
   cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
   cmd->add_flag("--correspondences", o->correspondences,
                 "Also write correspondences.csv: every tracked correspondence offered to the "
                 "filter with its true projection, label and fate (as `wingman run`)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
-  return {cmd, [o] { return slam_command(*o); }};
+  return {cmd, [o] { return for_each_variant(o->variants, [&](const std::string& v) { return slam_command(*o, v); }); }};
 }
 
 }  // namespace wingman::app

@@ -2,7 +2,10 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
+#include <string>
 #include <vector>
 
 #include "app/subcommand.hpp"
@@ -25,6 +28,16 @@ int run_cli(int argc, char** argv) {
       add_bench_frontend(cli),
   };
 
+  // A first word that is neither an option nor a command: say so and list the commands.
+  if (argc > 1 && argv[1][0] != '-') {
+    std::vector<std::string> names;
+    for (const auto& c : commands) names.push_back(c.cli->get_name());
+    if (std::find(names.begin(), names.end(), argv[1]) == names.end()) {
+      fmt::print(stderr, "error: unknown command '{}'; the commands are: {} (wingman --help)\n", argv[1],
+                 fmt::join(names, ", "));
+      return 2;
+    }
+  }
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -148,7 +148,7 @@ TEST_F(CliTest, RunWritesCompleteResultsDirectory) {
 
   // A selected variant is written into a folder named after it, as when all variants run.
   const fs::path dir = out / "multi";
-  for (const char* f : {"metrics.json", "steps.csv", "landmarks.csv", "map.ply",
+  for (const char* f : {"metrics.json", "steps.csv", "landmarks.csv", "map.ply", "config.yaml",
                         "traj/lead.est.tum", "traj/lead.gt.tum", "traj/uav1.est.tum",
                         "traj/uav1.gt.tum", "traj/uav2.est.tum", "traj/uav2.gt.tum"}) {
     EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
@@ -315,6 +315,39 @@ TEST_F(CliTest, BadCommandLineExits2) {
   const RunResult bogus = run_wingman({"run", kSmoke.string(), "--no-such-flag"}, tmp_.path());
   EXPECT_EQ(bogus.exit_code, 2) << bogus.output;
   EXPECT_THAT(bogus.output, HasSubstr("no-such-flag"));
+}
+
+TEST_F(CliTest, UnknownCommandIsNamedWithTheValidOnes) {
+  const RunResult r = run_wingman({"rnu", kSmoke.string()}, tmp_.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("unknown command 'rnu'; the commands are: run, montecarlo, observability, "
+                                  "render, slam, bench-frontend"));
+}
+
+// --print-config prints each selected variant's resolved configuration, the config.yaml a run
+// writes; --frames N and --duration (N-1)/rate keep the same steps.
+TEST_F(CliTest, PrintConfigIsTheWrittenConfigAndStepLimitsAgree) {
+  const RunResult printed =
+      run_wingman({"run", "scenes/smoke.yaml", "--variant", "single", "--print-config"}, tmp_.path());
+  ASSERT_EQ(printed.exit_code, 0) << printed.output;
+  EXPECT_THAT(printed.output, HasSubstr("mode: single"));
+  EXPECT_THAT(printed.output, HasSubstr("orientation_sigma: 0.028"));
+  const fs::path a = out_dir("frames"), b = out_dir("duration");
+  ASSERT_EQ(run_wingman({"run", "scenes/smoke.yaml", "--variant", "single", "--frames", "31", "--out",
+                         a.string(), "--no-plots", "-q"},
+                        tmp_.path())
+                .exit_code,
+            0);
+  ASSERT_EQ(run_wingman({"run", "scenes/smoke.yaml", "--variant", "single", "--duration", "3", "--out",
+                         b.string(), "--no-plots", "-q"},
+                        tmp_.path())
+                .exit_code,
+            0);
+  EXPECT_EQ(read_file(a / "single" / "config.yaml"), read_file(b / "single" / "config.yaml"));
+  EXPECT_THAT(read_file(a / "single" / "config.yaml"), HasSubstr("duration: 3\n"));
+  const auto m = nlohmann::json::parse(read_file(a / "single" / "metrics.json"));
+  EXPECT_EQ(m["steps"].get<int>(), 31);
+  EXPECT_EQ(run_wingman({"run", "scenes/smoke.yaml", "--frames", "1"}, tmp_.path()).exit_code, 2);
 }
 
 }  // namespace

@@ -1,0 +1,44 @@
+#include "app/cli_options.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "app/subcommand.hpp"
+
+namespace wingman::app {
+
+void add_variant_option(CLI::App* cmd, std::vector<std::string>& variants, const std::string& help) {
+  cmd->add_option("--variant", variants, help + " (repeatable: each in turn)");
+}
+
+int for_each_variant(const std::vector<std::string>& variants, const std::function<int(const std::string&)>& one) {
+  if (variants.empty()) return one("");
+  for (const auto& v : variants)
+    if (const int rc = one(v); rc != 0) return rc;
+  return 0;
+}
+
+void add_step_limit(CLI::App* cmd, StepLimit& limit) {
+  auto* d = cmd->add_option("--duration", limit.duration,
+                            "Only the first S seconds (phases and outages cut there)");
+  auto* f = cmd->add_option("--frames", limit.frames, "Only the first N frames (t = 0 included)");
+  d->excludes(f);
+}
+
+std::optional<double> StepLimit::seconds(double rate) const {
+  if (duration) {
+    if (!(*duration > 0)) throw UsageError(fmt::format("--duration: must be > 0, got {}", *duration));
+    return *duration;
+  }
+  if (frames) {
+    if (*frames < 2) throw UsageError(fmt::format("--frames: must be at least 2 (one step), got {}", *frames));
+    return (*frames - 1) / rate;
+  }
+  return std::nullopt;
+}
+
+void apply_step_limit(const StepLimit& limit, RunConfig& cfg) {
+  if (const auto s = limit.seconds(cfg.rate)) limit_duration(cfg, *s);
+}
+
+}  // namespace wingman::app

@@ -1,0 +1,35 @@
+// Options that mean the same on every command that takes them: --variant (repeatable: each named
+// variant in turn) and --duration S / --frames N (only the first S seconds, or the first N frames
+// t = 0, dt, ..., of a run; phases and outages are cut there).
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/run_config.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace wingman::app {
+
+void add_variant_option(CLI::App* cmd, std::vector<std::string>& variants, const std::string& help);
+// Runs `one` for each named variant, or once with "" when none was named; returns the first
+// non-zero exit code, or 0.
+int for_each_variant(const std::vector<std::string>& variants, const std::function<int(const std::string&)>& one);
+
+struct StepLimit {
+  std::optional<double> duration;
+  std::optional<int> frames;
+  bool any() const { return duration || frames; }
+  // The seconds it keeps of a run at `rate`; throws UsageError for a limit that keeps no step.
+  std::optional<double> seconds(double rate) const;
+};
+void add_step_limit(CLI::App* cmd, StepLimit& limit);
+// Cuts the run to the limit (limit_duration).
+void apply_step_limit(const StepLimit& limit, RunConfig& cfg);
+
+}  // namespace wingman::app
