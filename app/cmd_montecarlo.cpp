@@ -1,5 +1,5 @@
 // `wingman montecarlo`: N seeds of a scenario in parallel worker processes (each a `wingman run`
-// writing its own results directory under <out>/runs/), then the aggregate of DESIGN.md §7:
+// writing its own results directory under <out>/runs/), then the aggregate of docs/design.md, evaluation:
 // average NEES with its chi^2 bounds per step, the fraction of steps inside them per phase, and
 // the spread of Table 4 (eval/montecarlo), and every later variant compared with the first seed by
 // seed (eval/paired: the paper scenes' single-UAV against multi-UAV). Workers are processes, not

@@ -1,4 +1,4 @@
-// `wingman observability`: the observability analysis of paper section 4 (DESIGN.md §5) for a
+// `wingman observability`: the observability analysis of paper section 4 (docs/design.md, the estimator) for a
 // sensor set (a Table 1 preset or an explicit list), at a generic seeded state or at the state of
 // a scenario's trajectory; prints dim(x), the rank, the unobservable modes and per-state verdicts.
 #include "app/subcommand.hpp"
@@ -140,7 +140,7 @@ std::string describe_visibility(const std::vector<std::vector<int>>& vis) {
 }
 
 // The sensor set of a Table 1 preset: Quad 1 sees the lead and carries the altimeter and the
-// range sensor (paper section 7, DESIGN.md §3).
+// range sensor (paper section 7, docs/design.md, frames and conventions).
 slam::SensorSet preset(int config, int n2, int n1) {
   slam::SensorSet s = slam::SensorSet::empty(n2, n1);
   const auto c = config == 1 ? sim::Config::C1 : config == 2 ? sim::Config::C2 : sim::Config::C3;

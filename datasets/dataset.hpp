@@ -1,4 +1,4 @@
-// The on-disk dataset of DESIGN.md §8, what `wingman render` writes and a replay reads: one
+// The on-disk dataset of docs/design.md, files, what `wingman render` writes and a replay reads: one
 // folder per agent in the EuRoC/ASL layout,
 //   <agent>/cam0/data/<t_ns>.png, cam0/data.csv, cam0/sensor.yaml   colour (or gray) frames
 //   <agent>/depth0/data/<t_ns>.png, depth0/data.csv, depth0/sensor.yaml   16-bit depth, mm

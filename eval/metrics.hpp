@@ -1,4 +1,4 @@
-// Turns a RunRecord into the paper's tables (DESIGN.md §7): per-phase position MSE (Table 4),
+// Turns a RunRecord into the paper's tables (docs/design.md, evaluation): per-phase position MSE (Table 4),
 // landmark MSE (Table 5), outlier counts (Table 3), NEES, timings and map size. Step k == 0,
 // the known initial state, never enters a metric. Undefined values (empty sets) are NaN.
 #pragma once

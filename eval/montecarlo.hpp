@@ -1,4 +1,4 @@
-// Aggregation of N Monte Carlo runs of one scenario variant (paper Fig. 11, DESIGN.md §7): the
+// Aggregation of N Monte Carlo runs of one scenario variant (paper Fig. 11, docs/design.md, evaluation): the
 // average NEES per step with the two-sided 95 % chi^2 bounds for N runs,
 // [chi2_0.025(dof N) / N, chi2_0.975(dof N) / N], the fraction of steps inside them per phase,
 // and the mean and spread of the Table 4 metrics per phase. Reads what `wingman run` wrote.
@@ -55,7 +55,7 @@ struct MonteCarloPhase {
   std::vector<BlockNees> blocks;    // phases only (empty for "total" and for older runs)
 };
 
-// The fraction of steps inside the bounds that issue 3 asks of every phase.
+// The fraction of steps inside the 95 % bounds a consistent filter keeps in every phase.
 inline constexpr double kInsideTarget = 0.9;
 
 // 95 % half-width of the interval for the phase mean NEES from the runs' phase means.

@@ -1,5 +1,5 @@
-// Paired comparison of two variants of a scenario run on the same seeds (issue 6: "the single-UAV
-// baseline worse than multi-UAV"). Seed by seed the two variants share the truth and the sensor
+// Paired comparison of two variants of a scenario run on the same seeds (e.g. whether the
+// single-UAV baseline is worse than multi-UAV). Seed by seed the two variants share the truth and the sensor
 // noise, so their difference is measured far better paired than from the two means: per agent
 // and axis of the Table 4 totals and per axis of Table 5's final landmark MSE, on how many seeds
 // B is worse than A, the exact two-sided sign test of "as often worse as better", and the

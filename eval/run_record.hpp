@@ -1,6 +1,6 @@
 // What one run leaves for evaluation: per-step truth and estimates, the landmarks the filter
 // initialised with their truth, and the outlier bookkeeping. The pipeline (app/) fills it;
-// metrics.hpp turns it into the paper's tables (DESIGN.md §7) and writers.hpp into files.
+// metrics.hpp turns it into the paper's tables (docs/design.md, evaluation) and writers.hpp into files.
 #pragma once
 
 #include <Eigen/Core>

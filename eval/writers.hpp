@@ -1,4 +1,4 @@
-// Writes a run's results in formats other tools read (DESIGN.md §8): metrics.json, TUM
+// Writes a run's results in formats other tools read (docs/design.md, files): metrics.json, TUM
 // trajectories, per-step and landmark CSVs, the map as PLY, and a fixed-width summary for
 // stdout. NaN is written as JSON null and as "nan" in CSV. All writers throw
 // std::runtime_error naming the file if it cannot be written.

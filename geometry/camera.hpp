@@ -1,4 +1,4 @@
-// Pinhole camera with radial-tangential distortion (the paper's eq. 3 and 5; DESIGN.md §2).
+// Pinhole camera with radial-tangential distortion (the paper's eq. 3 and 5; docs/design.md, frames and conventions).
 // Pixel convention is OpenCV's: (0,0) is the centre of the top-left pixel, u = fx x/z + cx
 // before distortion. Jacobians are analytic; tests/geometry checks them numerically.
 #pragma once

@@ -1,5 +1,5 @@
 // Chi-square distribution: CDF and quantile, for the innovation gates of slam/ and the NEES
-// bounds of eval/ (DESIGN.md §7). Regularised incomplete gamma as in Numerical Recipes §6.2.
+// bounds of eval/ (docs/design.md, evaluation). Regularised incomplete gamma as in Numerical Recipes §6.2.
 #pragma once
 
 namespace wingman::geometry {

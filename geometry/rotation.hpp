@@ -1,4 +1,4 @@
-// Rotations and the frame conventions of DESIGN.md §2: world W is z-up, camera C is OpenCV's
+// Rotations and the frame conventions of docs/design.md, frames and conventions: world W is z-up, camera C is OpenCV's
 // (x right, y down, z forward), so a nadir camera has R_CW = diag(1, -1, -1).
 #pragma once
 
@@ -15,7 +15,7 @@ Eigen::Matrix3d rot_y(double a);
 Eigen::Matrix3d rot_z(double a);
 // Skew-symmetric matrix [v]x.
 Eigen::Matrix3d skew(const Eigen::Vector3d& v);
-// Gimbal error of DESIGN.md §2: a small rotation about the camera's x and y axes, applied in the
+// Gimbal error of docs/design.md, frames and conventions: a small rotation about the camera's x and y axes, applied in the
 // camera frame: R_CW_true = gimbal_error(e) * R_CW.
 Eigen::Matrix3d gimbal_error(double e);
 // Quaternion (x, y, z, w) of a rotation matrix, as TUM files write it.

@@ -1,7 +1,7 @@
 // The off-screen renderer: draws a Scene from any number of pinhole cameras and reads back
 // colour (RGB8) and metric depth (float metres along the optical axis, 0 where nothing was hit,
 // converted from the hardware depth buffer).
-// Pixels obey DESIGN.md §2 exactly: the projection puts u = fx x/z + cx at the centre of pixel
+// Pixels obey docs/design.md, frames and conventions exactly: the projection puts u = fx x/z + cx at the centre of pixel
 // column u (OpenCV's convention), and GL's bottom row is rendered as image row 0, so readback
 // needs no flip. Radial-tangential distortion, when the camera has it, is applied by cv::remap
 // from a wider pinhole render with maps computed once per camera. Every GL object (buffers,

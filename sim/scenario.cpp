@@ -1,4 +1,4 @@
-// The scenario model's non-inline functions (DESIGN.md §4 Table 1, §8). The YAML loader lives in
+// The scenario model's non-inline functions (docs/design.md, the estimator and files). The YAML loader lives in
 // scenario_yaml.cpp.
 #include "sim/scenario.hpp"
 

@@ -1,4 +1,4 @@
-// The scenario model (DESIGN.md §8): everything one run needs, loaded from one YAML file by
+// The scenario model (docs/design.md, files): everything one run needs, loaded from one YAML file by
 // load_scenario(). Defaults are the paper's section 7 setup; the YAML overrides them.
 #pragma once
 
@@ -128,7 +128,7 @@ struct NoiseSpec {
   double outlier_max_px = 15.0;                // error norm uniform in [0, outlier_max_px]
   double gimbal_amplitude = 0.04;              // rad, e_r = A sin(w t)
   double gimbal_omega = 0.3;                   // rad/s
-  // false: the paper's e_r for every camera about both axes (DESIGN.md §2). true: A sin(w t + phi)
+  // false: the paper's e_r for every camera about both axes (docs/design.md, frames and conventions). true: A sin(w t + phi)
   // with phi drawn per camera and axis from the seed, so that Monte Carlo runs see independent
   // gimbal errors, as the filter's model assumes, instead of one realisation every run.
   bool gimbal_random_phase = false;

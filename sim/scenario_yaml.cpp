@@ -1,4 +1,4 @@
-// Strict YAML loader for scenarios (DESIGN.md §8): unknown keys, duplicate keys, wrong types and
+// Strict YAML loader for scenarios (docs/design.md, files): unknown keys, duplicate keys, wrong types and
 // values out of range are errors of the form
 //   <file>:<line>:<col>: <key.path>: <what is wrong>
 // with the 1-based position of the offending node (the key for unknown/duplicate keys, the value

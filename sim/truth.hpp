@@ -1,5 +1,5 @@
 // Ground-truth motion of the open-loop runs: the lead follows the lemniscate of paper eq. 66 (or a
-// straight line) and every UAV the same curve shifted by its initial offset (DESIGN.md §3), each
+// straight line) and every UAV the same curve shifted by its initial offset (docs/design.md, frames and conventions), each
 // agent plus the random acceleration of noise.motion when the scenario asks for it; the cameras carry the
 // gimbal error e_r(t) = A sin(w t) about their x and y axes (or with a phase per camera and
 // axis, noise.gimbal_random_phase), which the filter never sees.

@@ -175,7 +175,7 @@ struct WorldSpec {
 
 // Terrain heights: seeded smooth relief around the mean height; with a ground lead, a flat road
 // under its path at the lead's true height minus its reference height (its wheels never float or
-// sink, DESIGN.md §3), and the land around it that road's height plus the relief.
+// sink, docs/design.md, frames and conventions), and the land around it that road's height plus the relief.
 class TerrainModel {
  public:
   TerrainModel(const Scenario& scn, const OpenLoopTruth& truth);

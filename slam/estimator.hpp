@@ -58,7 +58,7 @@ class Estimator {
   int num_cameras() const { return static_cast<int>(cams_.size()); }
   const FilterState& state() const { return s_; }
   const CameraRig& camera(int j) const { return cams_[j]; }
-  // The gimbal's commanded orientation, a known input (DESIGN.md §2).
+  // The gimbal's commanded orientation, a known input (docs/design.md, frames and conventions).
   void set_camera_rotation(int cam, const Eigen::Matrix3d& R_CW) { cams_[cam].R_CW = R_CW; }
 
   void predict(double dt);  // eq. 41-42

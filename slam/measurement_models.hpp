@@ -51,7 +51,7 @@ struct CameraRig {
 
 // The camera as the filter sees it at state x: when the state holds camera j's gimbal error
 // (gimbal_col >= 0), R_CW becomes R_x(a_x) R_y(a_y) R_CW, the truth's parametrisation of the error
-// (DESIGN.md §2), and the error is no longer marginalised as noise (orientation_sigma = 0).
+// (docs/design.md, frames and conventions), and the error is no longer marginalised as noise (orientation_sigma = 0).
 CameraRig estimated_rig(const Eigen::VectorXd& x, int gimbal_col, const CameraRig& cam);
 // d uv / d(a_x, a_y) of the projection of p_C = R_x(a_x) R_y(a_y) R_CW (p_W - x_c), at p_C:
 // d p_C / d a_x = [e_x]x p_C and d p_C / d a_y = [R_x(a_x) e_y]x p_C.

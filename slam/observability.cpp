@@ -240,7 +240,7 @@ EvaluationPoint generic_point(int num_uavs, int num_landmarks, unsigned long see
   for (int i = 0; i < num_landmarks; ++i) lm.push_back(vec(10, 10, 1, 0));
   EvaluationPoint p;
   p.state = make_filter_state(lead_pos, lead_vel, cp, cv, lm);
-  CameraRig rig;  // the paper's camera, nadir (DESIGN.md §2)
+  CameraRig rig;  // the paper's camera, nadir (docs/design.md, frames and conventions)
   rig.model = geometry::PinholeCamera(200.1, 200.1, 500, 500, 1000, 1000);
   rig.R_CW = geometry::nadir_R_CW();
   p.rigs.assign(static_cast<std::size_t>(num_uavs), rig);

@@ -1,5 +1,5 @@
 // Nonlinear observability analysis of paper section 4 (eq. 10-32, Table 2, Fig. 4) and
-// DESIGN.md §5: the observability matrix O = [d L^k_f h / dx], k = 0..K, for every measurement a
+// docs/design.md, the estimator: the observability matrix O = [d L^k_f h / dx], k = 0..K, for every measurement a
 // sensor set feeds, its rank by SVD, its right null space (the unobservable modes) and which
 // states those modes touch.
 //

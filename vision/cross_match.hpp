@@ -16,7 +16,7 @@
 
 namespace wingman::vision {
 
-// Camera pose as DESIGN.md §2 writes it: p_C = R_CW (p_W - position).
+// Camera pose as docs/design.md, frames and conventions writes it: p_C = R_CW (p_W - position).
 using CameraPose = geometry::CameraPose;
 
 struct CameraView {

@@ -82,7 +82,7 @@ class FeatureExtractor {
   explicit FeatureExtractor(const FeatureSettings& settings = {});
   const FeatureSettings& settings() const { return cfg_; }
   // Detects and describes; colour images are converted to grey. Keypoint coordinates follow
-  // DESIGN.md §2 (pixel (0,0) is the centre of the top-left pixel; ORB's upper pyramid levels
+  // docs/design.md, frames and conventions (pixel (0,0) is the centre of the top-left pixel; ORB's upper pyramid levels
   // are corrected to it, orb_keypoints_to_pixel_centres).
   Features detect(const cv::Mat& image, const std::vector<ExclusionBox>& exclude = {}) const;
   int norm() const;
@@ -96,7 +96,7 @@ class FeatureExtractor {
 // scale_factor^L, which ignores cv::resize's half-pixel alignment and the level's rounded size:
 // 0.1-0.7 px off in level 0's pixels, different per level, so a point seen at different levels
 // by two cameras (Quad 1 at 15 m, Quad 2 at 17 m) gets a biased disparity. This re-expresses
-// every keypoint of a level above 0 in level 0's pixel-centre coordinates (DESIGN.md §2).
+// every keypoint of a level above 0 in level 0's pixel-centre coordinates (docs/design.md, frames and conventions).
 void orb_keypoints_to_pixel_centres(std::vector<cv::KeyPoint>& keypoints, cv::Size image,
                                     float scale_factor);
 

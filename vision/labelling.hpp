@@ -1,6 +1,6 @@
 // Ground-truth labels of the frontend's correspondences, for evaluation only (the estimator never
 // sees them): a correspondence is an inlier when its pixel lies within a threshold of the true
-// projection (DESIGN.md §7: 3 px) and the point is visible there, i.e. the rendered depth at the
+// projection (docs/design.md, evaluation: 3 px) and the point is visible there, i.e. the rendered depth at the
 // true projection agrees with the point's depth (not occluded by something nearer).
 #pragma once
 
@@ -33,12 +33,12 @@ struct LabelResult {
 };
 
 // Depth images are metric z-depth (along the optical axis) as CV_32F (metres) or CV_16U
-// (millimetres, DESIGN.md §8), sampled at the nearest pixel centre; 0, NaN and inf mean "no
+// (millimetres, docs/design.md, files), sampled at the nearest pixel centre; 0, NaN and inf mean "no
 // surface". An empty Mat skips the depth test.
 std::optional<double> sample_depth(const cv::Mat& depth, const Eigen::Vector2d& uv);
 
 // World point through a pixel: its ray scaled to the rendered depth there, with the true pose.
-// This is also the ground truth of a landmark in rendered mode (DESIGN.md §7).
+// This is also the ground truth of a landmark in rendered mode (docs/design.md, evaluation).
 std::optional<Eigen::Vector3d> back_project(const Eigen::Vector2d& uv, const geometry::PinholeCamera& cam,
                                             const CameraPose& true_pose, const cv::Mat& depth);
 

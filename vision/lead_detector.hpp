@@ -1,5 +1,5 @@
 // Lead-agent detector: finds the lead in an image and returns the pixel of its reference point
-// (DESIGN.md §3: the centre of its roof marker), or nothing. Primary cue: an ArUco marker
+// (docs/design.md, frames and conventions: the centre of its roof marker), or nothing. Primary cue: an ArUco marker
 // (dictionary and id configurable, DICT_4X4_50 id 0 by default); its centre is the intersection of
 // the marker's diagonals, which is the exact image of the square's centre under perspective (the
 // mean of the corners is not). Fallback: a distinctive colour panel (HSV range) whose largest blob
@@ -55,7 +55,7 @@ struct LeadDetectorSettings {
 enum class LeadSource { Marker, Colour };
 
 struct LeadDetection {
-  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // the reference point, DESIGN.md §2 pixels
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // the reference point, docs/design.md, frames and conventions pixels
   // Heuristic in [0, 1]: markers min(1, side / 16 px), halved when several markers with the id
   // are seen; colour blobs 0.5 x their fill of the bounding box.
   double confidence = 0;

@@ -12,6 +12,7 @@
 
 #include "app/run_config.hpp"
 #include "app_test_support.hpp"
+#include "gl_required.hpp"
 #include "datasets/dataset.hpp"
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
@@ -57,7 +58,7 @@ TEST(RenderCli, WritesADatasetThatReadsBackAndMatchesADirectRender) {
   try {
     ctx = render::create_gl_context(render::GlBackend::OsMesa);
   } catch (const render::GlContextError& e) {
-    GTEST_SKIP() << e.what();
+    WINGMAN_NO_GL_CONTEXT(e.what());
   }
   app::RunConfig s = app::load_run_configs(scn.string()).front();
   s.seed = 5;

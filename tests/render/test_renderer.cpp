@@ -1,4 +1,4 @@
-// The renderer against the pinhole model of DESIGN.md §2, with both backends: a small bright
+// The renderer against the pinhole model of docs/design.md, frames and conventions, with both backends: a small bright
 // square lands within 0.3 px of its predicted pixel at the centre and near the corners; depth
 // read back matches the true distance within 1 cm at 20 m; rendering is deterministic.
 #include <gtest/gtest.h>
@@ -172,6 +172,26 @@ TEST(GlContext, WhenNothingWorksTheErrorListsWhatWasTriedAndWhy) {
                  "no OpenGL context could be created; tried:\n  egl: no devices\n  osmesa: "
                  "cannot load libfoo.so.1");
   }
+}
+
+}  // namespace
+}  // namespace wingman::render
+
+namespace wingman::render {
+namespace {
+
+// The policy of WINGMAN_NO_GL_CONTEXT: CI=true (and only that) turns a missing context into a
+// failure, so a CI run cannot pass without rendering.
+TEST(GlTestPolicy, OnlyCiTrueRequiresAContext) {
+  const char* saved = std::getenv("CI");
+  const std::string keep = saved ? saved : "";
+  setenv("CI", "true", 1);
+  EXPECT_TRUE(::wingman::testing::gl_required());
+  setenv("CI", "false", 1);
+  EXPECT_FALSE(::wingman::testing::gl_required());
+  unsetenv("CI");
+  EXPECT_FALSE(::wingman::testing::gl_required());
+  if (saved) setenv("CI", keep.c_str(), 1);
 }
 
 }  // namespace
