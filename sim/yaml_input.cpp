@@ -225,17 +225,28 @@ std::string read_string(const Ctx& ctx, const Field& f) {
   return s;
 }
 
-Eigen::Vector3d read_vec3(const Ctx& ctx, const Field& f, Bounds b) {
-  if (!f.node.IsSequence() || f.node.size() != 3) {
-    ctx.fail(f.loc(), fmt::format("expected a list of 3 numbers, got {}",
+namespace {
+
+// A list of exactly N numbers, each within b; `scalar_too`: one number stands for all N.
+template <int N>
+Eigen::Matrix<double, N, 1> read_list(const Ctx& ctx, const Field& f, Bounds b, bool scalar_too,
+                                      const char* what) {
+  if (scalar_too && f.node.IsScalar()) return Eigen::Matrix<double, N, 1>::Constant(read_number(ctx, f, b));
+  if (!f.node.IsSequence() || f.node.size() != N) {
+    ctx.fail(f.loc(), fmt::format("expected {}, got {}", what,
                                   f.node.IsSequence() ? fmt::format("a list of {}", f.node.size())
                                                       : describe(f.node)));
   }
-  Eigen::Vector3d v;
-  for (std::size_t i = 0; i < 3; ++i)
-    v[static_cast<Eigen::Index>(i)] =
-        read_number(ctx, Field{f.node[i], f.key_mark, index_path(f.path, i)}, b);
+  Eigen::Matrix<double, N, 1> v;
+  for (std::size_t i = 0; i < N; ++i)
+    v[static_cast<Eigen::Index>(i)] = read_number(ctx, Field{f.node[i], f.key_mark, index_path(f.path, i)}, b);
   return v;
+}
+
+}  // namespace
+
+Eigen::Vector3d read_vec3(const Ctx& ctx, const Field& f, Bounds b) {
+  return read_list<3>(ctx, f, b, false, "a list of 3 numbers");
 }
 
 geometry::Distortion read_distortion(const Ctx& ctx, const Field& f) {
@@ -249,17 +260,7 @@ geometry::Distortion read_distortion(const Ctx& ctx, const Field& f) {
   return geometry::Distortion{k[0], k[1], k[2], k[3], k[4]};
 }
 Eigen::Vector4d read_vec4(const Ctx& ctx, const Field& f, Bounds b) {
-  if (f.node.IsScalar()) return Eigen::Vector4d::Constant(read_number(ctx, f, b));
-  if (!f.node.IsSequence() || f.node.size() != 4) {
-    ctx.fail(f.loc(), fmt::format("expected a number or a list of 4 numbers (x, y, z, yaw), got {}",
-                                  f.node.IsSequence() ? fmt::format("a list of {}", f.node.size())
-                                                      : describe(f.node)));
-  }
-  Eigen::Vector4d v;
-  for (std::size_t i = 0; i < 4; ++i)
-    v[static_cast<Eigen::Index>(i)] =
-        read_number(ctx, Field{f.node[i], f.key_mark, index_path(f.path, i)}, b);
-  return v;
+  return read_list<4>(ctx, f, b, true, "a number or a list of 4 numbers (x, y, z, yaw)");
 }
 
 }  // namespace wingman::sim
