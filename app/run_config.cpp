@@ -14,16 +14,13 @@ namespace wingman::app {
 
 namespace {
 
-// sim's keys of the control: section (ControlSpec); the others are the controller's.
-const std::vector<std::string_view> kControlSimKeys = {"settling_time", "disturbance", "uavs"};
-
 // The controller's settings, with sim's keys of the same map accepted and left to sim.
 struct ControlSection {
   control::SlidingModeSettings& settings;
   template <class V>
   void visit(V& v) {
     settings.visit(v);
-    for (std::string_view key : kControlSimKeys) v.other(key);
+    for (std::string_view key : sim::ControlSpec::kKeys) v.other(key);
   }
 };
 

@@ -6,8 +6,10 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace wingman::sim {
@@ -22,6 +24,8 @@ struct UavControlSpec {
 };
 
 struct ControlSpec {
+  // The keys of the control: section that are sim's; the others are the controller's.
+  static constexpr std::array<std::string_view, 3> kKeys = {"settling_time", "disturbance", "uavs"};
   bool enabled = false;  // set by the presence of the section
   // Delta_g of eq. 58, added to u = [-vx, -vy, vz, w] of every UAV: each component a sum of two
   // sinusoids with random frequencies and phases, |Delta_g_i| <= bound_i.
