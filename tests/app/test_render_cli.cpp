@@ -29,7 +29,7 @@ std::string tiny_scenario(double duration, const std::string& world = "{texture:
   s += std::to_string(duration);
   s += "\nuavs:\n  - {name: uav1, initial_position: [-1.5, 0, 15], sees_lead: true, altimeter: true, range: true, ";
   s += cam;
-  s += "}\n  - {name: uav2, initial_position: [1.5, 0, 17], ";
+  s += "}\n  - {name: uav2, initial_position: [1.5, 0, 17], range: false, ";
   s += cam;
   s += "}\nworld: ";
   s += world;
@@ -51,7 +51,8 @@ TEST(RenderCli, WritesADatasetThatReadsBackAndMatchesADirectRender) {
   EXPECT_NE(ds.info.renderer.find("osmesa"), std::string::npos);
   EXPECT_EQ(ds.agent("uav1").altimeter.size(), 2u);
   EXPECT_EQ(ds.agent("lead").gps.size(), 2u);
-  EXPECT_TRUE(ds.agent("uav2").range.empty());
+  EXPECT_EQ(ds.agent("uav2").altimeter.size(), 2u);  // carried unless switched off
+  EXPECT_TRUE(ds.agent("uav2").range.empty());          // switched off: no samples
   EXPECT_TRUE(fs::exists(out / "scenario.yaml"));
 
   std::unique_ptr<render::GlContext> ctx;
