@@ -179,8 +179,8 @@ void emit_phases(YAML::Emitter& out, const RunConfig& cfg) {
   out << YAML::Key << "phases" << YAML::Value << YAML::BeginSeq;
   for (const auto& p : cfg.phases) {
     out << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << p.name << YAML::Key << "from"
-        << YAML::Value << fmt::format("{}", p.t_start) << YAML::Key << "to" << YAML::Value
-        << fmt::format("{}", p.t_end) << YAML::Key << "config" << YAML::Value << sim::to_string(p.config);
+        << YAML::Value << sim::number_text(p.t_start) << YAML::Key << "to" << YAML::Value
+        << sim::number_text(p.t_end) << YAML::Key << "config" << YAML::Value << sim::to_string(p.config);
     if (!p.add.empty()) out << YAML::Key << "add" << YAML::Value << YAML::Flow << sensor_names(p.add);
     if (!p.remove.empty()) out << YAML::Key << "remove" << YAML::Value << YAML::Flow << sensor_names(p.remove);
     out << YAML::EndMap;
@@ -189,8 +189,8 @@ void emit_phases(YAML::Emitter& out, const RunConfig& cfg) {
   out << YAML::Key << "outages" << YAML::Value << YAML::BeginSeq;
   for (const auto& o : cfg.outages) {
     out << YAML::Flow << YAML::BeginMap << YAML::Key << "sensor" << YAML::Value << sim::to_string(o.sensor)
-        << YAML::Key << "from" << YAML::Value << fmt::format("{}", o.t_start) << YAML::Key << "to"
-        << YAML::Value << fmt::format("{}", o.t_end);
+        << YAML::Key << "from" << YAML::Value << sim::number_text(o.t_start) << YAML::Key << "to"
+        << YAML::Value << sim::number_text(o.t_end);
     if (!o.agent.empty()) out << YAML::Key << "agent" << YAML::Value << o.agent;
     out << YAML::EndMap;
   }
@@ -201,17 +201,18 @@ void emit_control(YAML::Emitter& out, const RunConfig& cfg) {
   if (!cfg.closed_loop()) return;
   const auto& c = cfg.control;
   out << YAML::Key << "control" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "settling_time" << YAML::Value << fmt::format("{}", c.settling_time);
-  out << YAML::Key << "disturbance" << YAML::Value << YAML::BeginMap << YAML::Key << "bound" << YAML::Value
-      << YAML::Flow << std::vector<double>(c.disturbance_bound.data(), c.disturbance_bound.data() + 4);
+  out << YAML::Key << "settling_time" << YAML::Value << sim::number_text(c.settling_time);
+  out << YAML::Key << "disturbance" << YAML::Value << YAML::BeginMap << YAML::Key << "bound" << YAML::Value;
+  sim::emit_numbers(out, c.disturbance_bound);
   if (c.disturbance_seed) out << YAML::Key << "seed" << YAML::Value << *c.disturbance_seed;
   out << YAML::EndMap << YAML::Key << "uavs" << YAML::Value << YAML::BeginSeq;
   for (const auto& u : c.uavs) {
-    out << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << u.uav << YAML::Key
-        << "initial_yaw" << YAML::Value << fmt::format("{}", u.initial_yaw) << YAML::Key << "lambda_d"
-        << YAML::Value << std::vector<double>(u.lambda_d.data(), u.lambda_d.data() + 3) << YAML::Key
-        << "yaw_d" << YAML::Value << (u.yaw_d ? fmt::format("{}", *u.yaw_d) : std::string("lead_bearing"))
-        << YAML::EndMap;
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << u.uav;
+    out << YAML::Key << "initial_yaw" << YAML::Value << sim::number_text(u.initial_yaw);
+    out << YAML::Key << "lambda_d" << YAML::Value;
+    sim::emit_numbers(out, u.lambda_d);
+    out << YAML::Key << "yaw_d" << YAML::Value << (u.yaw_d ? sim::number_text(*u.yaw_d) : "lead_bearing");
+    out << YAML::EndMap;
   }
   out << YAML::EndSeq;
   control::SlidingModeSettings controller = cfg.controller;
@@ -230,8 +231,8 @@ std::string config_yaml(const RunConfig& cfg) {
       << YAML::Newline;
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << cfg.name;
-  out << YAML::Key << "duration" << YAML::Value << fmt::format("{}", cfg.duration);
-  out << YAML::Key << "rate" << YAML::Value << fmt::format("{}", cfg.rate);
+  out << YAML::Key << "duration" << YAML::Value << sim::number_text(cfg.duration);
+  out << YAML::Key << "rate" << YAML::Value << sim::number_text(cfg.rate);
   out << YAML::Key << "seed" << YAML::Value << cfg.seed;
   out << YAML::Key << "measurements" << YAML::Value << sim::to_string(cfg.measurements);
   sim::emit_settings(out, "lead", cfg.lead);

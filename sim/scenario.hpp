@@ -1,5 +1,7 @@
-// The scenario model (docs/design.md, files): everything one run needs, loaded from one YAML file by
-// load_scenario(). Defaults are the paper's section 7 setup; the YAML overrides them.
+// The scenario model, sim's part of a run (docs/design.md, settings): truth, sensors, noise and
+// world, loaded from one YAML file by load_scenarios(). Defaults are the paper's section 7 setup;
+// the YAML overrides them. The sections other modules define are kept unread in settings_layers
+// (app/run_config.hpp composes them).
 #pragma once
 
 #include <Eigen/Core>

@@ -23,6 +23,17 @@ namespace wingman::sim {
 // Where each key that was read came from, by key path ("estimator.map.max_landmarks").
 using KeyLocations = std::map<std::string, Loc>;
 
+// A number as settings print it: the shortest text that reads back to the same double.
+inline std::string number_text(double x) { return fmt::format("{}", x); }
+
+// A fixed-length vector as a flow list of such numbers.
+template <int N>
+void emit_numbers(YAML::Emitter& out, const Eigen::Matrix<double, N, 1>& v) {
+  out << YAML::Flow << YAML::BeginSeq;
+  for (int i = 0; i < N; ++i) out << number_text(v[i]);
+  out << YAML::EndSeq;
+}
+
 namespace settings_detail {
 
 // First pass over one map level: the keys it accepts.
@@ -168,11 +179,8 @@ class Emitter {
   void put(const geometry::Distortion& d) { put(Eigen::Matrix<double, 5, 1>(d.k1, d.k2, d.p1, d.p2, d.k3)); }
   template <int N>
   void put(const Eigen::Matrix<double, N, 1>& v) {
-    out_ << YAML::Flow << YAML::BeginSeq;
-    for (int i = 0; i < N; ++i) out_ << number_text(v[i]);
-    out_ << YAML::EndSeq;
+    emit_numbers(out_, v);
   }
-  static std::string number_text(double x) { return fmt::format("{}", x); }
   YAML::Emitter& out_;
 };
 
