@@ -52,12 +52,6 @@ void read_layer(const sim::SettingsLayer& layer, RunConfig& cfg, Provenance& pro
   prov.ctx = &layer.ctx;
 }
 
-std::string uav_names(const sim::Scenario& s) {
-  std::vector<std::string_view> names;
-  for (const auto& u : s.uavs) names.push_back(u.name);
-  return sim::join(names);
-}
-
 [[noreturn]] void fail_at(const Provenance& prov, const RunConfig& cfg, const sim::Loc* loc,
                           const std::string& what) {
   if (loc && prov.ctx) prov.ctx->fail(*loc, what);
@@ -74,7 +68,7 @@ void resolve_estimator(RunConfig& cfg, const Provenance& prov) {
   if (!single && cfg.uav_index(e.single_uav) < 0) e.single_uav = cfg.uavs.front().name;
   if (cfg.uav_index(e.single_uav) < 0)
     fail_at(prov, cfg, single,
-            fmt::format("'{}' is not a UAV of this scenario (UAVs: {})", e.single_uav, uav_names(cfg)));
+            fmt::format("'{}' is not a UAV of this scenario (UAVs: {})", e.single_uav, cfg.uav_names()));
   if (e.mode == slam::EstimatorMode::MultiUav && cfg.uavs.size() < 2)
     fail_at(prov, cfg, mode, fmt::format("mode multi needs at least 2 UAVs, the scenario has {}", cfg.uavs.size()));
   if (cfg.closed_loop() && e.mode == slam::EstimatorMode::SingleUav)

@@ -147,6 +147,12 @@ bool Scenario::sensor_active(Sensor s, double t, const std::string& agent) const
   return true;
 }
 
+std::string Scenario::uav_names() const {
+  std::string out;
+  for (const UavSpec& u : uavs) out += (out.empty() ? "" : ", ") + u.name;
+  return out;
+}
+
 int Scenario::uav_index(const std::string& name) const {
   for (std::size_t i = 0; i < uavs.size(); ++i) {
     if (uavs[i].name == name) return static_cast<int>(i);

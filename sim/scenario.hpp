@@ -227,6 +227,7 @@ struct Scenario {
   // Whether a sensor kind is fed at time t for an agent ("lead" or a UAV name).
   bool sensor_active(Sensor s, double t, const std::string& agent) const;
   int uav_index(const std::string& name) const;  // -1 when absent
+  std::string uav_names() const;                  // "uav1, uav2", for messages
   bool closed_loop() const { return control.enabled; }
 };
 

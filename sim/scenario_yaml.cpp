@@ -291,12 +291,6 @@ void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& pro
       s.settings_layers.push_back(std::make_shared<const SettingsLayer>(SettingsLayer{std::string(key), ctx, *f}));
 }
 
-std::string uav_names(const Scenario& s) {
-  std::vector<std::string_view> names;
-  for (const UavSpec& u : s.uavs) names.push_back(u.name);
-  return join(names);
-}
-
 // Defaults that depend on other fields, then the checks that involve the whole scenario.
 void finalise(const Ctx& ctx, Scenario& s, const Provenance& prov) {
   if (!prov.phases_given) {
@@ -320,7 +314,7 @@ void finalise(const Ctx& ctx, Scenario& s, const Provenance& prov) {
     if (!a.empty() && a != "lead" && s.uav_index(a) < 0)
       ctx.fail(prov.outage_agent[i],
                fmt::format("unknown agent '{}' (expected lead or one of the UAVs: {})", a,
-                           uav_names(s)));
+                           s.uav_names()));
   }
 }
 
