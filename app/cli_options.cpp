@@ -41,4 +41,20 @@ void apply_step_limit(const StepLimit& limit, RunConfig& cfg) {
   if (const auto s = limit.seconds(cfg.rate)) limit_duration(cfg, *s);
 }
 
+void add_force_flag(CLI::App* cmd, bool& force) {
+  cmd->add_flag("--force", force,
+                "Replace the output directory if it already holds wingman output (by default an "
+                "existing one is refused; a directory wingman did not write is never replaced)");
+}
+
+void stage_output(std::optional<eval::ResultsDir>& staged, const std::filesystem::path& out,
+                  const std::string& kind, bool force) {
+  try {
+    staged.emplace(out, eval::ResultsDir::Options{kind, force});
+  } catch (const std::runtime_error& e) {
+    throw UsageError(e.what());
+  }
+  for (const auto& note : staged->notes()) fmt::print(stderr, "note: {}\n", note);
+}
+
 }  // namespace wingman::app

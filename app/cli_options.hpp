@@ -1,6 +1,7 @@
 // Options that mean the same on every command that takes them: --variant (repeatable: each named
 // variant in turn) and --duration S / --frames N (only the first S seconds, or the first N frames
-// t = 0, dt, ..., of a run; phases and outages are cut there).
+// t = 0, dt, ..., of a run; phases and outages are cut there), and --force with the staged output
+// directory every writing command opens the same way.
 #pragma once
 
 #include <functional>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "app/run_config.hpp"
+#include "eval/results_dir.hpp"
 
 namespace CLI {
 class App;
@@ -31,5 +33,13 @@ struct StepLimit {
 void add_step_limit(CLI::App* cmd, StepLimit& limit);
 // Cuts the run to the limit (limit_duration).
 void apply_step_limit(const StepLimit& limit, RunConfig& cfg);
+
+// --force: replace an existing output directory of wingman's (never a foreign one).
+void add_force_flag(CLI::App* cmd, bool& force);
+// Opens the staged output directory `out` (kind "results" or "dataset") into `staged`: refused
+// with a UsageError, before any work, when `out` exists and --force was not given; leftovers of
+// killed processes beside it are cleaned up and named on stderr.
+void stage_output(std::optional<eval::ResultsDir>& staged, const std::filesystem::path& out,
+                  const std::string& kind, bool force);
 
 }  // namespace wingman::app

@@ -25,10 +25,12 @@
 #include <optional>
 #include <thread>
 
+#include "app/montecarlo_study.hpp"
 #include "app/progress.hpp"
 #include "app/subcommand.hpp"
 #include "app/cli_options.hpp"
 #include "app/variants.hpp"
+#include "eval/atomic_file.hpp"
 #include "eval/montecarlo.hpp"
 #include "eval/paired.hpp"
 #include "eval/plots.hpp"
@@ -125,20 +127,14 @@ int montecarlo_command(const MonteCarloOptions& o) {
       o.out.empty() ? fs::path("results") / (scenarios.front().name + "_montecarlo") : fs::path(o.out);
   const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
 
-  // The output directory: new, or one of ours (refused without --resume if it holds runs).
+  // The output directory: new, or one of ours (refused without --resume if it holds runs, and
+  // with other settings than its runs were made with).
   std::error_code ec;
   if (fs::exists(out)) {
     if (!fs::is_directory(out) || (!fs::exists(out / kMarker) && !fs::is_empty(out, ec)))
       throw UsageError(fmt::format("{}: exists and is not a wingman Monte Carlo directory; choose "
                                    "another --out", out.string()));
   }
-  fs::create_directories(out / "runs");
-  std::ofstream(out / kMarker) << o.scenario << "\n";
-  // Staging directories of workers that were stopped: never complete, always safe to drop.
-  for (const auto& e : fs::directory_iterator(out / "runs"))
-    if (e.is_directory() && e.path().filename().string().find(".partial-") != std::string::npos)
-      fs::remove_all(e.path(), ec);
-
   std::vector<std::uint64_t> pending, finished;
   for (int i = 0; i < o.runs; ++i) {
     const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
@@ -152,6 +148,16 @@ int montecarlo_command(const MonteCarloOptions& o) {
       pending.push_back(seed);
     }
   }
+  const std::string settings = study_settings(scenarios, o.limit);
+  if (fs::exists(out / kStudySettingsFile)) record_or_check_study(out, settings);
+  fs::create_directories(out / "runs");
+  eval::write_file_atomic(out / kMarker, o.scenario + "\n");
+  record_or_check_study(out, settings);
+  // Staging directories of workers that were stopped: never complete, always safe to drop.
+  for (const auto& e : fs::directory_iterator(out / "runs"))
+    if (e.is_directory() && e.path().filename().string().find(".partial-") != std::string::npos)
+      fs::remove_all(e.path(), ec);
+
   if (!o.quiet && !finished.empty())
     fmt::print(stderr, "resuming: {} of {} runs already finished\n", finished.size(), o.runs);
 
@@ -237,7 +243,8 @@ int montecarlo_command(const MonteCarloOptions& o) {
                  dirs.size(), o.batch);
     }
   }
-  eval::write_monte_carlo(summaries, out);
+  const eval::MonteCarloProvenance prov{o.scenario, file_fnv1a64(o.scenario), finished, failed};
+  eval::write_monte_carlo(summaries, out, prov);
   // Every later variant against the first, seed by seed (the paper scenes: single against multi).
   std::vector<eval::PairedComparison> comparisons;
   for (std::size_t v = 1; v < variant_runs.size(); ++v)

@@ -1,7 +1,7 @@
 // `wingman render`: renders every UAV camera at every step of the open-loop truth and writes an
 // image dataset with depth, sensor samples and ground truth (datasets/dataset.hpp). The dataset
 // is staged next to --out and renamed into place only when complete, so a failed or interrupted
-// run (Ctrl-C included) never leaves a directory that looks finished.
+// run (Ctrl-C and SIGTERM included, app/interrupt.hpp) never leaves a directory that looks finished.
 #include "app/cli_options.hpp"
 #include "app/subcommand.hpp"
 #include "app/variants.hpp"
@@ -9,15 +9,14 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <random>
 
+#include "app/interrupt.hpp"
 #include "app/progress.hpp"
 #include "app/version.hpp"
 #include "datasets/dataset.hpp"
@@ -38,27 +37,6 @@ namespace wingman::app {
 
 namespace {
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted = true; }
-
-// SIGINT/SIGTERM set a flag the frame loop checks; the previous handlers come back on exit.
-class InterruptGuard {
- public:
-  InterruptGuard() {
-    g_interrupted = false;
-    old_int_ = std::signal(SIGINT, on_interrupt);
-    old_term_ = std::signal(SIGTERM, on_interrupt);
-  }
-  ~InterruptGuard() {
-    std::signal(SIGINT, old_int_);
-    std::signal(SIGTERM, old_term_);
-  }
-
- private:
-  void (*old_int_)(int) = SIG_DFL;
-  void (*old_term_)(int) = SIG_DFL;
-};
-
 struct RenderOptions {
   std::string scenario;
   std::string out;
@@ -67,6 +45,7 @@ struct RenderOptions {
   std::vector<std::string> variants;
   StepLimit limit;
   bool gray = false;
+  bool force = false;
   bool quiet = false;
 };
 
@@ -106,7 +85,6 @@ int render_command(const RenderOptions& o, const std::string& variant) {
   }
   const RunConfig scn = pick(o, variant);
   const int n = steps_to_render(o, scn);
-  InterruptGuard guard;  // from here on Ctrl-C is noticed at the next step and cleans up
   fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);
   if (o.variants.size() > 1) out /= scn.variant;
 
@@ -117,11 +95,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
     throw UsageError(fmt::format("{}: world: {}", o.scenario, e.what()));
   }
   std::optional<eval::ResultsDir> staged;
-  try {
-    staged.emplace(out);
-  } catch (const std::runtime_error& e) {
-    throw UsageError(e.what());
-  }
+  stage_output(staged, out, "dataset", o.force);
   const auto ctx = render::create_gl_context(backend);
   render::Renderer renderer(*ctx, scene);
   scene = {};  // uploaded; free the CPU copy
@@ -158,11 +132,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
   ProgressLine progress(fmt::format("[render {}]", scn.name), o.quiet);
   const auto start = std::chrono::steady_clock::now();
   for (int k = 0; k <= n; ++k) {
-    if (g_interrupted) {
-      progress.finish();
-      fmt::print(stderr, "interrupted: nothing written to {} (staging removed)\n", out.string());
-      return 130;
-    }
+    throw_if_interrupted();  // unwinds through the staging directory: nothing half-written
     const double t = k * scn.dt();
     const std::int64_t t_ns = datasets::step_ns(k, scn.rate);
     const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
@@ -218,6 +188,7 @@ Subcommand add_render(CLI::App& parent) {
                      "each, OUT/<variant>)");
   add_step_limit(cmd, o->limit);
   cmd->add_flag("--gray", o->gray, "Write 8-bit gray frames instead of RGB");
+  add_force_flag(cmd, o->force);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] {
             return for_each_variant(o->variants, [&](const std::string& v) { return render_command(*o, v); });

@@ -37,6 +37,7 @@ struct RunOptions {
   bool no_plots = false;
   bool no_prefetch = false;
   bool correspondences = false;
+  bool force = false;
   bool quiet = false;
   bool print_config = false;
   StepLimit limit;
@@ -64,11 +65,7 @@ int run_command(const RunOptions& o) {
 
   const fs::path out = o.out.empty() ? fs::path("results") / scenarios.front().name : fs::path(o.out);
   std::optional<eval::ResultsDir> staged;
-  try {
-    staged.emplace(out);  // refuses a directory that is not a wingman results directory
-  } catch (const std::runtime_error& e) {
-    throw UsageError(e.what());
-  }
+  stage_output(staged, out, "results", o.force);
   eval::ResultsDir& results = *staged;
   const bool nested = scenarios.size() > 1 || !scenarios.front().variant.empty();
 
@@ -156,6 +153,7 @@ Subcommand add_run(CLI::App& parent) {
                 "correspondence offered to the filter with its true projection, label and whether "
                 "the filter accepted it (about 5 MB for the 210 s paper scene; "
                 "tools/track_error.py reads it)");
+  add_force_flag(cmd, o->force);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return run_command(*o); }};
 }

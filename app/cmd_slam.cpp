@@ -36,6 +36,7 @@ struct SlamOptions {
   StepLimit limit;
   bool no_plots = false;
   bool correspondences = false;
+  bool force = false;
   bool quiet = false;
 };
 
@@ -52,11 +53,7 @@ int slam_command(const SlamOptions& o, const std::string& variant) {
   fs::path out = o.out.empty() ? fs::path("results") / (scn.name + "_replay") : fs::path(o.out);
   if (o.variants.size() > 1) out /= scn.variant;
   std::optional<eval::ResultsDir> staged;
-  try {
-    staged.emplace(out);
-  } catch (const std::runtime_error& e) {
-    throw UsageError(e.what());
-  }
+  stage_output(staged, out, "results", o.force);
   ProgressLine progress(fmt::format("[slam {}]", scn.name), o.quiet);
   eval::RunRecord rec;
   try {
@@ -93,6 +90,7 @@ Subcommand add_slam(CLI::App& parent) {
   cmd->add_flag("--correspondences", o->correspondences,
                 "Also write correspondences.csv: every tracked correspondence offered to the "
                 "filter with its true projection, label and fate (as `wingman run`)");
+  add_force_flag(cmd, o->force);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return for_each_variant(o->variants, [&](const std::string& v) { return slam_command(*o, v); }); }};
 }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "app/interrupt.hpp"
 #include "app/subcommand.hpp"
 #include "app/version.hpp"
 #include "sim/scenario.hpp"
@@ -44,9 +45,13 @@ int run_cli(int argc, char** argv) {
     const int rc = cli.exit(e);
     return rc == 0 ? 0 : 2;
   }
+  InterruptGuard interrupts;
   try {
     for (const auto& c : commands)
       if (c.cli->parsed()) return c.run();
+  } catch (const Interrupted& e) {
+    fmt::print(stderr, "\n{}\n", e.what());
+    return e.exit_code();
   } catch (const sim::ScenarioError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 2;

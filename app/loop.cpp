@@ -1,12 +1,17 @@
 #include "app/loop.hpp"
 
 #include <Eigen/Cholesky>
+#include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <random>
 
+#include "app/interrupt.hpp"
 #include "app/timing.hpp"
+#include "slam/health.hpp"
 #include "app/version.hpp"
 #include "sim/rng.hpp"
 
@@ -14,21 +19,28 @@ namespace wingman::app {
 
 namespace {
 
+// A NEES is a squared Mahalanobis distance: below zero or not finite, the covariance it was
+// computed with is not positive definite, and every figure after it would be meaningless.
+double checked_nees(double nees, const char* block) {
+  if (nees >= 0 && std::isfinite(nees)) return nees;
+  throw slam::NumericalFailure(fmt::format("numerical failure: the NEES of {} block is {} (its covariance "
+                                           "is not positive definite)", block, nees));
+}
+
 // NEES (eq. 67) over the agents' positions and velocities.
 double agent_nees(const slam::FilterState& s, const Eigen::VectorXd& truth) {
   const int d = s.kinematic_dim();
   const Eigen::VectorXd e = truth - s.x.head(d);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(s.P.topLeftCorner(d, d));
-  if (ldlt.info() != Eigen::Success) return eval::kNaN;
-  return e.dot(ldlt.solve(e));
+  return checked_nees(ldlt.info() == Eigen::Success ? e.dot(ldlt.solve(e)) : eval::kNaN, "the agents'");
 }
 
 // NEES of one 3-vector block of the state against its marginal covariance.
 double block_nees(const slam::FilterState& s, int pos, const Eigen::Vector3d& truth) {
   const Eigen::Vector3d e = truth - s.x.segment<3>(pos);
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(s.P.block<3, 3>(pos, pos));
-  if (ldlt.info() != Eigen::Success) return eval::kNaN;
-  return e.dot(ldlt.solve(e));
+  return checked_nees(ldlt.info() == Eigen::Success ? e.dot(ldlt.solve(e)) : eval::kNaN,
+                      slam::describe_state_element(s, pos).c_str());
 }
 
 // The filter at t = 0: the truth, or the truth plus a draw of the initial covariance.
@@ -100,6 +112,8 @@ class Run {
   void record_step(int k, double t, const StepCounts& n, const StepTimes& tm);
   void snapshot_landmarks(int phase);
   int cameras() const { return static_cast<int>(cam_uav_.size()); }
+  const RunConfig& cfg() const { return cfg_; }
+  const sim::Truth& truth() const { return truth_; }
   bool active(sim::Sensor s, double t, int cam) const {
     return cfg_.sensor_active(s, t, cfg_.uavs[cam_uav_[cam]].name);
   }
@@ -314,6 +328,40 @@ void Run::record_step(int k, double t, const StepCounts& n, const StepTimes& tm)
   rec.steps.push_back(std::move(st));
 }
 
+// One step k > 0 at time t: predict, measure, update, initialise, record, control.
+void run_step(Run& run, MeasurementSource& source, const LoopHooks& hooks, int k, double t) {
+  const RunConfig& cfg = run.cfg();
+  const int phase = cfg.phase_at(t);
+  if (hooks.advance) hooks.advance(k, t);
+  StepTimes tm;
+  StepCounts n;
+  auto t0 = Clock::now();
+  run.est.predict(cfg.dt());
+  tm.predict = ms_since(t0);
+  // The gimbal's commanded orientation is a known input (nadir).
+  for (int j = 0; j < run.cameras(); ++j) run.est.set_camera_rotation(j, run.truth().commanded_R_CW());
+  const StageTimes st = source.begin_step(k, t, run.est);
+  // Stage times add up to the step's wall time: detection is what it added beyond producing
+  // the frames (it overlaps the next camera's); its full duration is the source's to report.
+  tm.render = st.render_ms;
+  tm.detect = std::max(0.0, st.wall_ms - st.render_ms);
+  run.update(t, n, tm);
+  run.snapshot_landmarks(phase);
+  run.initialise(t, phase, n, tm);
+  run.end_step(t);
+  source.end_step(t);
+  run.record_step(k, t, n, tm);
+  if (hooks.control) hooks.control(k, t, run.est, run.rec.steps.back());
+}
+
+// Which UAV each filter camera is, for messages that name cameras by index.
+std::string camera_legend(const eval::RunRecord& rec) {
+  std::vector<std::string> parts;
+  for (std::size_t j = 1; j < rec.agent_names.size(); ++j)
+    parts.push_back(fmt::format("camera {} is {}", j - 1, rec.agent_names[j]));
+  return fmt::format("{}", fmt::join(parts, ", "));
+}
+
 }  // namespace
 
 eval::RunRecord run_loop(const RunConfig& cfg, const sim::Truth& truth, MeasurementSource& source,
@@ -324,28 +372,14 @@ eval::RunRecord run_loop(const RunConfig& cfg, const sim::Truth& truth, Measurem
   if (hooks.control) hooks.control(0, 0.0, run.est, run.rec.steps.back());
   const int N = cfg.num_steps();
   for (int k = 1; k <= N; ++k) {
+    throw_if_interrupted();  // SIGINT/SIGTERM: stop between steps, the caller's staging goes
     const double t = k * cfg.dt();
-    const int phase = cfg.phase_at(t);
-    if (hooks.advance) hooks.advance(k, t);
-    StepTimes tm;
-    StepCounts n;
-    auto t0 = Clock::now();
-    run.est.predict(cfg.dt());
-    tm.predict = ms_since(t0);
-    // The gimbal's commanded orientation is a known input (nadir).
-    for (int j = 0; j < run.cameras(); ++j) run.est.set_camera_rotation(j, truth.commanded_R_CW());
-    const StageTimes st = source.begin_step(k, t, run.est);
-    // Stage times add up to the step's wall time: detection is what it added beyond producing
-    // the frames (it overlaps the next camera's); its full duration is the source's to report.
-    tm.render = st.render_ms;
-    tm.detect = std::max(0.0, st.wall_ms - st.render_ms);
-    run.update(t, n, tm);
-    run.snapshot_landmarks(phase);
-    run.initialise(t, phase, n, tm);
-    run.end_step(t);
-    source.end_step(t);
-    run.record_step(k, t, n, tm);
-    if (hooks.control) hooks.control(k, t, run.est, run.rec.steps.back());
+    try {
+      run_step(run, source, hooks, k, t);
+    } catch (const slam::NumericalFailure& e) {
+      throw slam::NumericalFailure(fmt::format("{}: step {} (t = {} s; {}): {}", cfg.source_path, k, t,
+                                               camera_legend(run.rec), e.what()));
+    }
     if (observer) observer(k, run.est.state());
     if (progress) progress(k, N);
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "eval/atomic_file.hpp"
 #include "eval/json_file.hpp"
 #include "eval/nees_null.hpp"
 #include "geometry/chi2.hpp"
@@ -302,7 +303,8 @@ BatchTest test_batches(const std::string& label, const RunSet& runs, std::size_t
   return bt;
 }
 
-void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs::path& dir) {
+void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs::path& dir,
+                       const MonteCarloProvenance& prov) {
   json out = json::array();
   for (const auto& m : summaries) {
     json j;
@@ -350,24 +352,29 @@ void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs
     }
     out.push_back(j);
   }
-  const fs::path json_path = dir / "montecarlo.json";
-  std::ofstream(json_path) << out.dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+  json failed = json::array();
+  for (const auto& [seed, why] : prov.failed) failed.push_back({{"seed", seed}, {"reason", why}});
+  const json doc{{"scenario", prov.scenario},
+                 {"scenario_fnv1a64", prov.scenario_hash},
+                 {"seeds", prov.seeds},
+                 {"failed_seeds", failed},
+                 {"variants", out}};
+  write_file_atomic(dir / "montecarlo.json", doc.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
 
-  std::ofstream csv(dir / "nees.csv");
-  csv << "t";
-  for (const auto& m : summaries) csv << "," << m.label << "_nees," << m.label << "_lower," << m.label << "_upper";
-  csv << "\n";
+  std::string csv = "t";
+  for (const auto& m : summaries) csv += fmt::format(",{0}_nees,{0}_lower,{0}_upper", m.label);
+  csv += "\n";
   const std::size_t steps = summaries.empty() ? 0 : summaries.front().t.size();
   for (std::size_t k = 0; k < steps; ++k) {
-    csv << fmt::format("{:.6f}", summaries.front().t[k]);
+    csv += fmt::format("{:.6f}", summaries.front().t[k]);
     for (const auto& m : summaries) {
       const double v = k < m.average_nees.size() ? m.average_nees[k] : kNaN;
-      csv << "," << (std::isfinite(v) ? fmt::format("{:.6g}", v) : "NaN") << ","
-          << fmt::format("{:.6g},{:.6g}", m.lower, m.upper);
+      csv += "," + (std::isfinite(v) ? fmt::format("{:.6g}", v) : "") + "," +
+             fmt::format("{:.6g},{:.6g}", m.lower, m.upper);
     }
-    csv << "\n";
+    csv += "\n";
   }
-  if (!csv) throw std::runtime_error(fmt::format("{}: write failed", (dir / "nees.csv").string()));
+  write_file_atomic(dir / "nees.csv", csv);
 }
 
 std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries) {

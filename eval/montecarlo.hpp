@@ -8,9 +8,11 @@
 // the runs beside how many of them a consistent filter would pass.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "eval/run_record.hpp"
@@ -114,9 +116,18 @@ MonteCarloSummary aggregate_runs(const std::string& label,
                                  const std::vector<std::filesystem::path>& run_dirs);
 MonteCarloSummary aggregate_runs(const std::string& label, const RunSet& runs);
 
-// montecarlo.json (every summary), nees.csv (t and, per summary, average NEES and bounds).
+// What montecarlo.json says about the study besides its summaries.
+struct MonteCarloProvenance {
+  std::string scenario;       // the scenario file
+  std::string scenario_hash;  // FNV-1a 64 of its bytes, hex
+  std::vector<std::uint64_t> seeds;                                // aggregated
+  std::vector<std::pair<std::uint64_t, std::string>> failed;      // seed, why
+};
+
+// montecarlo.json ({scenario, scenario_fnv1a64, seeds, failed_seeds, variants: every summary})
+// and nees.csv (t and, per summary, average NEES and bounds), each written atomically.
 void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries,
-                       const std::filesystem::path& dir);
+                       const std::filesystem::path& dir, const MonteCarloProvenance& prov = {});
 // A readable table: per summary and phase, the fraction of steps inside the bounds and the Table
 // 4 means with their standard deviations.
 std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries);

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "eval/atomic_file.hpp"
 #include "eval/json_file.hpp"
 
 namespace wingman::eval {
@@ -233,9 +234,7 @@ void write_paired(const std::vector<PairedComparison>& comparisons, const fs::pa
                            {"ratio_ci95", {r.ratio_lo, r.ratio_hi}}});
     out.push_back(j);
   }
-  std::ofstream f(path);
-  f << out.dump(2, ' ', false, json::error_handler_t::replace) << "\n";
-  if (!f) throw std::runtime_error(fmt::format("{}: write failed", path.string()));
+  write_file_atomic(path, out.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
 }
 
 }  // namespace wingman::eval

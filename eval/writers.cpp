@@ -9,20 +9,15 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "eval/atomic_file.hpp"
+
 namespace wingman::eval {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-void write_file(const fs::path& path, std::string_view content) {
-  if (path.has_parent_path()) fs::create_directories(path.parent_path());
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw std::runtime_error("cannot open '" + path.string() + "' for writing");
-  out.write(content.data(), static_cast<std::streamsize>(content.size()));
-  out.close();
-  if (!out) throw std::runtime_error("failed writing '" + path.string() + "'");
-}
+void write_file(const fs::path& path, std::string_view content) { write_file_atomic(path, content); }
 
 json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
@@ -42,8 +37,13 @@ json stats(const Stats& s) {
           {"max", num(s.max)}, {"count", s.count}};
 }
 
-// CSV cell for a double: shortest text that reads back to the same value; "nan" for NaN.
-void put(fmt::memory_buffer& b, double v) { fmt::format_to(std::back_inserter(b), ",{}", v); }
+// CSV cell for a double: shortest text that reads back to the same value; an empty field where
+// there is no value (the NEES at step 0, a landmark never removed), so that a "nan" or "inf" in
+// a CSV is never a value wingman wrote on purpose.
+void put(fmt::memory_buffer& b, double v) {
+  if (std::isfinite(v)) fmt::format_to(std::back_inserter(b), ",{}", v);
+  else fmt::format_to(std::back_inserter(b), ",");
+}
 void put3(fmt::memory_buffer& b, const Eigen::Vector3d& v) {
   put(b, v.x());
   put(b, v.y());

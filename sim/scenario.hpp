@@ -240,6 +240,8 @@ class ScenarioError : public std::runtime_error {
 // Loads and validates the scenario's own sections (sim's: truth, sensors, noise, world); the
 // sections other modules define are kept in settings_layers, unread (app/run_config.hpp reads them). A file with `variants:` yields one Scenario per variant
 // (each the base with that variant's overrides); otherwise exactly one.
+// A scenario file is refused past this size, before it is parsed.
+inline constexpr std::size_t kMaxScenarioBytes = std::size_t{4} << 20;
 std::vector<Scenario> load_scenarios(const std::string& path);
 // Same, from YAML text; `origin` stands for the file name in messages.
 std::vector<Scenario> parse_scenarios(const std::string& yaml_text, const std::string& origin);

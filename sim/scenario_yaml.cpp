@@ -19,6 +19,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "sim/budget.hpp"
 #include "sim/scenario.hpp"
 #include "sim/settings_yaml.hpp"
 #include "sim/yaml_input.hpp"
@@ -30,14 +31,35 @@ namespace {
 constexpr double kTimeEps = 1e-9;
 
 
+// Names become directory and file names and JSON keys: short, and plain ASCII.
+constexpr std::size_t kMaxNameLength = 64;
+
 bool name_ok(const std::string& s, bool allow_dash) {
-  if (s.empty()) return false;
+  if (s.empty() || s.size() > kMaxNameLength) return false;
   for (char c : s) {
     const bool ok =
         (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || (allow_dash && c == '-');
     if (!ok) return false;
   }
   return true;
+}
+
+bool scenario_name_ok(const std::string& s) {
+  if (s.empty() || s.size() > kMaxNameLength || s.front() == '.' || s.front() == '-') return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '.' || c == '-';
+  });
+}
+
+// A name as a message may print it: bytes outside printable ASCII as \xNN, at most 80 of them.
+std::string printable(const std::string& s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size() && i < 80; ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    out += c >= 0x20 && c < 0x7f ? std::string(1, static_cast<char>(c)) : fmt::format("\\x{:02x}", c);
+  }
+  return s.size() > 80 ? out + fmt::format("... ({} bytes)", s.size()) : out;
 }
 
 const std::vector<std::string_view> kSensorNames = {"landmarks", "lead_projection", "altimeter",
@@ -88,7 +110,14 @@ struct Provenance {
   bool phases_given = false;
   std::vector<Loc> phase_to;      // per phase, its `to` value
   std::vector<Loc> outage_agent;  // per outage, its `agent` value (invalid when absent)
+  KeyLocations keys;              // size-driving keys as set: "duration", "landmarks.density", ...
 };
+
+// Where a key was set, or its path marked as a default.
+Loc key_loc(const Provenance& prov, const std::string& path) {
+  if (auto it = prov.keys.find(path); it != prov.keys.end()) return it->second;
+  return Loc{YAML::Mark::null_mark(), path + " (default)"};
+}
 
 Loc loc_of(const std::optional<Field>& f) { return f ? f->loc() : Loc{}; }
 
@@ -116,7 +145,8 @@ void parse_uavs(const Ctx& ctx, const Field& f, std::vector<UavSpec>& uavs, Prov
     if (u.name == "lead")
       ctx.fail(name_loc, "'lead' is reserved for the lead agent; choose another UAV name");
     if (!name_ok(u.name, false))
-      ctx.fail(name_loc, fmt::format("UAV names must match [a-z0-9_]+, got '{}'", u.name));
+      ctx.fail(name_loc, fmt::format("UAV names must match [a-z0-9_]+ and be at most {} characters, got '{}'",
+                                     kMaxNameLength, printable(u.name)));
     for (std::size_t j = 0; j < uavs.size(); ++j) {
       if (uavs[j].name == u.name)
         ctx.fail(name_loc, fmt::format("duplicate UAV name '{}' (first at line {})", u.name,
@@ -124,6 +154,7 @@ void parse_uavs(const Ctx& ctx, const Field& f, std::vector<UavSpec>& uavs, Prov
     }
     uavs.push_back(std::move(u));
     name_locs.push_back(name_loc);
+    prov.keys.insert(where.begin(), where.end());
   }
 }
 
@@ -152,6 +183,9 @@ void parse_phases(const Ctx& ctx, const Field& f, std::vector<Phase>& phases, Pr
     p.source_line = item.loc().mark.line + 1;
     auto nf = m.get("name");
     if (nf) p.name = read_string(ctx, *nf);
+    if (nf && !scenario_name_ok(p.name))
+      ctx.fail(nf->loc(), fmt::format("phase names must match [A-Za-z0-9_.-]+ and be at most {} characters, "
+                                      "got '{}'", kMaxNameLength, printable(p.name)));
     const Field from = m.require("from", item.loc());
     const Field to = m.require("to", item.loc());
     read_window(ctx, from, to, p.t_start, p.t_end);
@@ -281,14 +315,66 @@ const std::vector<std::string_view> kCommonKeys = {"seed",      "duration", "noi
 void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& prov) {
   if (auto f = m.get("seed")) s.seed = read_seed(ctx, *f);
   num(ctx, m, "duration", s.duration, gt(0));
+  if (auto f = m.get("duration")) prov.keys["duration"] = f->loc();
   if (auto f = m.get("noise")) read_settings(ctx, *f, s.noise);
-  if (auto f = m.get("landmarks")) read_settings(ctx, *f, s.field);
+  if (auto f = m.get("landmarks")) read_settings(ctx, *f, s.field, &prov.keys);
   if (auto f = m.get("phases")) parse_phases(ctx, *f, s.phases, prov);
   if (auto f = m.get("outages")) parse_outages(ctx, *f, s.outages, prov);
   if (auto f = m.get("control")) parse_control(ctx, *f, s.control, s.uavs);
   for (std::string_view key : {"estimator", "control", "frontend"})
     if (auto f = m.get(key))
       s.settings_layers.push_back(std::make_shared<const SettingsLayer>(SettingsLayer{std::string(key), ctx, *f}));
+}
+
+// The run's size against what it drives and the machine (sim/budget.hpp).
+void check_budget(const Ctx& ctx, const Scenario& s, const Provenance& prov) {
+  using L = RunLimits;
+  const double steps = s.duration * s.rate;
+  if (!(steps <= L::kMaxSteps))
+    ctx.fail(key_loc(prov, "duration"), fmt::format("{} s at rate {} Hz is {:.3g} steps; at most {:.3g}",
+                                                    s.duration, s.rate, steps, L::kMaxSteps));
+  if (std::llround(steps) < 1)
+    ctx.fail(key_loc(prov, "duration"), fmt::format("{} s at rate {} Hz is shorter than one step ({} s): "
+                                                    "the run would have no step", s.duration, s.rate, s.dt()));
+  if (s.uavs.size() > static_cast<std::size_t>(L::kMaxUavs))
+    ctx.fail(prov.uavs, fmt::format("{} UAVs; at most {}", s.uavs.size(), L::kMaxUavs));
+  auto check_position = [&](const Eigen::Vector3d& p, const std::string& path) {
+    if (p.cwiseAbs().maxCoeff() > L::kMaxCoordinate)
+      ctx.fail(key_loc(prov, path), fmt::format("[{}, {}, {}] is farther than {:.3g} m from the origin in "
+                                                "some axis", p.x(), p.y(), p.z(), L::kMaxCoordinate));
+  };
+  check_position(s.lead.initial_position, "lead.initial_position");
+  for (std::size_t i = 0; i < s.uavs.size(); ++i)
+    check_position(s.uavs[i].initial_position, fmt::format("uavs[{}].initial_position", i));
+  const RunEstimate e = estimate_run(s);
+  const std::string traj = s.lead.trajectory.type == "line" ? "velocity" : "scale";
+  if (!(e.extent_m <= 2 * L::kMaxCoordinate))
+    ctx.fail(key_loc(prov, "lead.trajectory." + traj),
+             fmt::format("the flight spans {:.3g} m; at most {:.3g}", e.extent_m, 2 * L::kMaxCoordinate));
+  const bool rendered = s.measurements == MeasurementMode::Rendered;
+  if (!rendered && !(e.landmarks <= L::kMaxLandmarks))
+    ctx.fail(key_loc(prov, "landmarks.density"),
+             fmt::format("{} points/m^2 over the flight's {:.3g} m plus {} m of margin is {:.3g} "
+                         "landmarks; at most {:.3g}", s.field.density, e.extent_m, s.field.margin,
+                         e.landmarks, L::kMaxLandmarks));
+  if (rendered && !(e.terrain_vertices <= L::kMaxTerrainVertices))
+    ctx.fail(key_loc(prov, s.world.terrain.extent > 0 ? "world.terrain.extent" : "world.terrain.resolution"),
+             fmt::format("the terrain mesh would have {:.3g} vertices; at most {:.3g} (raise resolution "
+                         "or lower extent/margin)", e.terrain_vertices, L::kMaxTerrainVertices));
+  if (rendered && !(e.pixels <= L::kMaxPixelsPerStep))
+    ctx.fail(prov.uavs, fmt::format("the cameras have {:.3g} pixels in all; at most {:.3g}", e.pixels,
+                                    L::kMaxPixelsPerStep));
+  const double mem = memory_available();
+  if (!(e.bytes <= mem))
+    ctx.fail(key_loc(prov, "duration"),
+             fmt::format("this run would need about {} of memory ({:.3g} steps, {:.3g} landmarks, {:.3g} "
+                         "terrain vertices, {:.3g} pixels a step); this machine allows {}",
+                         bytes_text(e.bytes), steps, rendered ? 0.0 : e.landmarks, e.terrain_vertices,
+                         e.pixels, bytes_text(mem)));
+  if (!(e.seconds <= L::kMaxSeconds))
+    ctx.fail(key_loc(prov, "duration"),
+             fmt::format("this run would take about {} on two cores ({:.3g} steps); at most {}",
+                         duration_text(e.seconds), steps, duration_text(L::kMaxSeconds)));
 }
 
 // Defaults that depend on other fields, then the checks that involve the whole scenario.
@@ -316,6 +402,7 @@ void finalise(const Ctx& ctx, Scenario& s, const Provenance& prov) {
                fmt::format("unknown agent '{}' (expected lead or one of the UAVs: {})", a,
                            s.uav_names()));
   }
+  check_budget(ctx, s, prov);
 }
 
 std::vector<UavSpec> paper_uavs() {
@@ -349,8 +436,15 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   base.uavs = paper_uavs();
   Provenance prov;
 
-  if (auto f = top.get("name")) base.name = read_string(ctx, *f);
+  if (auto f = top.get("name")) {
+    base.name = read_string(ctx, *f);
+    if (!scenario_name_ok(base.name))
+      ctx.fail(f->loc(), fmt::format("the scenario's name names its results directory: it must match "
+                                     "[A-Za-z0-9_.-]+, not start with '.' or '-', and be at most {} "
+                                     "characters, got '{}'", kMaxNameLength, printable(base.name)));
+  }
   num(ctx, top, "rate", base.rate, in(0, 1000, true, false));
+  if (auto f = top.get("rate")) prov.keys["rate"] = f->loc();
   if (auto f = top.get("measurements")) {
     const std::string& s = scalar_of(ctx, *f, "a measurement mode");
     if (s == "synthetic")
@@ -361,9 +455,9 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
       ctx.fail(f->loc(), fmt::format(
                              "unknown measurement mode '{}' (expected 'synthetic' or 'rendered')", s));
   }
-  if (auto f = top.get("lead")) read_settings(ctx, *f, base.lead);
+  if (auto f = top.get("lead")) read_settings(ctx, *f, base.lead, &prov.keys);
   if (auto f = top.get("uavs")) parse_uavs(ctx, *f, base.uavs, prov);
-  if (auto f = top.get("world")) read_settings(ctx, *f, base.world);
+  if (auto f = top.get("world")) read_settings(ctx, *f, base.world, &prov.keys);
   apply_common(ctx, top, base, prov);
 
   std::vector<Scenario> out;
@@ -390,7 +484,8 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
     const Field nf = m.require("name", item.loc());
     const std::string name = read_string(ctx, nf);
     if (!name_ok(name, true))
-      ctx.fail(nf.loc(), fmt::format("variant names must match [a-z0-9_-]+, got '{}'", name));
+      ctx.fail(nf.loc(), fmt::format("variant names must match [a-z0-9_-]+ and be at most {} characters, got '{}'",
+                                     kMaxNameLength, printable(name)));
     for (std::size_t j = 0; j < out.size(); ++j) {
       if (out[j].variant == name)
         ctx.fail(nf.loc(), fmt::format("duplicate variant name '{}' (first at line {})", name,
@@ -441,14 +536,23 @@ std::vector<Scenario> load_scenarios(const std::string& path) {
     throw ScenarioError(
         fmt::format("{}: cannot read scenario: {}", path, std::strerror(err != 0 ? err : ENOENT)));
   }
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read at most one byte past the limit, so /dev/zero or a mistaken multi-gigabyte file is
+  // refused after 4 MiB, not after filling the memory.
+  std::string text(kMaxScenarioBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) {
     const int err = errno;
     throw ScenarioError(
         fmt::format("{}: cannot read scenario: {}", path, std::strerror(err != 0 ? err : EIO)));
   }
-  return parse_scenarios(text.str(), path);
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxScenarioBytes)
+    throw ScenarioError(fmt::format("{}: larger than {} MiB; a scenario file is a few kilobytes of YAML",
+                                    path, kMaxScenarioBytes >> 20));
+  if (text.find('\0') != std::string::npos)
+    throw ScenarioError(fmt::format("{}: holds a NUL byte at offset {}; a scenario file is YAML text", path,
+                                    text.find('\0')));
+  return parse_scenarios(text, path);
 }
 
 }  // namespace wingman::sim

@@ -219,9 +219,35 @@ bool read_bool(const Ctx& ctx, const Field& f) {
   ctx.fail(f.loc(), fmt::format("expected true or false, got '{}'", s));
 }
 
+namespace {
+
+// Well-formed UTF-8 (no overlong forms, surrogates or code points past U+10FFFF).
+bool valid_utf8(const std::string& s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    const int n = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xe ? 2 : (c >> 3) == 0x1e ? 3 : -1;
+    if (n < 0 || i + n >= s.size()) return false;
+    std::uint32_t cp = n == 0 ? c : c & (0x3f >> n);
+    for (int k = 1; k <= n; ++k) {
+      const unsigned char d = static_cast<unsigned char>(s[i + k]);
+      if ((d >> 6) != 0x2) return false;
+      cp = (cp << 6) | (d & 0x3f);
+    }
+    const std::uint32_t min[] = {0, 0x80, 0x800, 0x10000};
+    if (cp < min[n] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return false;
+    i += n + 1;
+  }
+  return true;
+}
+
+}  // namespace
+
 std::string read_string(const Ctx& ctx, const Field& f) {
   const std::string& s = scalar_of(ctx, f, "a string");
   if (s.empty()) ctx.fail(f.loc(), "expected a non-empty string");
+  if (s.size() > kMaxStringBytes)
+    ctx.fail(f.loc(), fmt::format("a string of {} bytes; at most {}", s.size(), kMaxStringBytes));
+  if (!valid_utf8(s)) ctx.fail(f.loc(), "not valid UTF-8 text");
   return s;
 }
 

@@ -100,6 +100,8 @@ long long read_integer(const Ctx& ctx, const Field& f, long long lo, long long h
 int read_int(const Ctx& ctx, const Field& f, int lo, int hi = std::numeric_limits<int>::max());
 std::uint64_t read_seed(const Ctx& ctx, const Field& f);
 bool read_bool(const Ctx& ctx, const Field& f);
+// Strings (names, file paths) are UTF-8 and at most this long.
+inline constexpr std::size_t kMaxStringBytes = 4096;
 std::string read_string(const Ctx& ctx, const Field& f);
 // A list of 3 numbers, each within b.
 Eigen::Vector3d read_vec3(const Ctx& ctx, const Field& f, Bounds b = any_value());

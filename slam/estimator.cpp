@@ -1,9 +1,13 @@
 #include "slam/estimator.hpp"
 
+#include <fmt/core.h>
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <stdexcept>
 
 #include "slam/ekf_update.hpp"
+#include "slam/health.hpp"
 #include "slam/motion_model.hpp"
 
 namespace wingman::slam {
@@ -45,6 +49,7 @@ void Estimator::predict(double dt) {
   for (int j = 0; j < num_cameras(); ++j)
     predict_gimbal_error(s_, j, dt, cams_[j].orientation_sigma, cfg_.measurement_noise.orientation_time_constant);
   predict_common_acceleration(s_, dt, q.common_state_sigma, q.common_state_time_constant);
+  check_state(s_, "the prediction");
 }
 
 std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
@@ -68,10 +73,17 @@ VisualUpdateResult Estimator::update_visual(
   for (const auto& [cam, uv] : lead_pixels)
     if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.measurement_noise.pixel_sigma))
       lead.push_back(std::move(*m));
+  for (const auto& m : lead) check_measurement(m, fmt::format("the lead's pixel in camera {}", m.camera));
+  for (const auto& c : candidates)
+    if (!c.uv.allFinite())
+      throw NumericalFailure(fmt::format("numerical failure: the pixel of landmark {} in camera {} is not finite",
+                                         c.id, c.cam));
   VisualUpdateResult r = update_with_correspondences(s_, cams_, candidates, cfg_.gating,
                                                      cfg_.measurement_noise.pixel_sigma, rng_, lead);
   for (size_t i = 0; i < candidates.size(); ++i)
     if (r.accepted[i]) tracks_[candidates[i].id].matched = true;
+  check_state(s_, fmt::format("the visual update ({} landmark pixels, {} lead pixels)", candidates.size(),
+                              lead.size()));
   return r;
 }
 
@@ -85,8 +97,14 @@ SensorUpdateResult Estimator::update_sensors(const SensorBatch& b) {
   SensorUpdateResult r;
   r.offered = static_cast<int>(ms.size());
   if (ms.empty()) return r;
+  std::vector<std::string> names;
+  if (b.gps) names.push_back("the GPS fix");
+  for (const auto& [cam, z] : b.altimeter) names.push_back(fmt::format("camera {}'s altimeter", cam));
+  for (const auto& [cam, z] : b.range) names.push_back(fmt::format("camera {}'s range", cam));
+  for (std::size_t i = 0; i < ms.size(); ++i) check_measurement(ms[i], names[i]);
   const auto ok = update_with_gated_measurements(s_, ms, cfg_.gating.probability);
   r.accepted = static_cast<int>(std::count(ok.begin(), ok.end(), true));
+  check_state(s_, fmt::format("the sensor update ({})", fmt::join(names, ", ")));
   return r;
 }
 
@@ -112,6 +130,10 @@ void Estimator::forget(LandmarkId id) {
 std::vector<InitOutcome> Estimator::initialise_from_matches(const std::vector<CrossMatch>& matches) {
   std::vector<InitOutcome> out;
   out.reserve(matches.size());
+  for (const auto& m : matches)
+    if (!m.uv_a.allFinite() || !m.uv_b.allFinite())
+      throw NumericalFailure(fmt::format("numerical failure: a cross match's pixels in cameras {} and {} are "
+                                         "not finite", m.cam_a, m.cam_b));
   for (const auto& m : matches) {
     if (!make_room()) {
       out.push_back({std::nullopt, "map full"});
@@ -127,13 +149,17 @@ std::vector<InitOutcome> Estimator::initialise_from_matches(const std::vector<Cr
     if (r.id) tracks_[*r.id].matched = true;  // seen now: no miss on its first step
     out.push_back(std::move(r));
   }
+  if (!matches.empty()) check_state(s_, "cooperative landmark initialisation");
   return out;
 }
 
 InitOutcome Estimator::initialise_from_pixel(int cam, const Eigen::Vector2d& uv) {
+  if (!uv.allFinite())
+    throw NumericalFailure(fmt::format("numerical failure: a new landmark's pixel in camera {} is not finite", cam));
   if (!make_room()) return {std::nullopt, "map full"};
   auto r = initialise_inverse_depth(s_, cam, cams_[cam], uv, cfg_.initialisation, cfg_.measurement_noise);
   if (r.id) tracks_[*r.id].matched = true;
+  check_state(s_, fmt::format("a landmark's initialisation from camera {}", cam));
   return r;
 }
 
@@ -148,6 +174,7 @@ std::vector<LandmarkId> Estimator::end_step() {
   std::sort(drop.begin(), drop.end());
   for (LandmarkId id : drop) forget(id);
   for (int j = 0; j < num_cameras(); ++j) convert_linear_landmarks(s_, j, cfg_.initialisation.linearity_threshold);
+  check_covariance(s_, "the step's map management");
   std::vector<LandmarkId> removed;
   removed.swap(evicted_);
   return removed;

@@ -6,7 +6,7 @@
 A and B are results directories (`wingman run --out`) or trees of them (as written by
 tools/regress_scenes.sh). Every steps.csv, landmarks.csv and metrics.json under A is compared
 with the file at the same relative path under B: CSVs row by row, without the per-stage timing
-columns (t_*_ms); metrics.json key by key, without wall times, timings, the software version and
+columns (t_*_ms), an empty field and "nan" both meaning no value; metrics.json key by key, without wall times, timings, the software version and
 the scenario's path. Prints one line per results directory ("identical" or the first difference,
 named by file, row or key path) and exits 1 when anything differs or is missing.
 """
@@ -28,6 +28,11 @@ def is_timing_column(name):
     return name.startswith("t_") and name.endswith("_ms")
 
 
+def missing(cell):
+    """An absent value: wingman writes an empty field; older versions wrote nan."""
+    return cell == "" or cell.lower() == "nan"
+
+
 def compare_csv(a, b):
     with open(a, newline="") as fa, open(b, newline="") as fb:
         ra, rb = list(csv.reader(fa)), list(csv.reader(fb))
@@ -40,7 +45,7 @@ def compare_csv(a, b):
         return f"{len(ra) - 1} rows vs {len(rb) - 1}"
     for r, (x, y) in enumerate(zip(ra, rb)):
         for i in keep:
-            if x[i] != y[i]:
+            if x[i] != y[i] and not (missing(x[i]) and missing(y[i])):
                 return f"row {r}, column {ra[0][i]}: {x[i]} vs {y[i]}"
     return None
 

@@ -23,6 +23,11 @@ import sys
 from pathlib import Path
 
 
+def cell(text):
+    """A CSV value; an empty field is a value wingman does not have (NaN)."""
+    return float(text) if text else float("nan")
+
+
 def seed_dirs(root, variant):
     dirs = [d / variant for d in Path(root).iterdir() if (d / variant / "steps.csv").is_file()]
     return sorted(dirs, key=lambda p: (len(p.parent.name), p.parent.name))
@@ -41,8 +46,8 @@ def agent_table(runs, agents=("lead", "uav1")):
         for r in rows:
             for a in agents:
                 for ax in "xyz":
-                    e = float(r[f"{a}_p{ax}_est"]) - float(r[f"{a}_p{ax}_true"])
-                    sig = float(r[f"{a}_s{ax}"])
+                    e = cell(r[f"{a}_p{ax}_est"]) - cell(r[f"{a}_p{ax}_true"])
+                    sig = cell(r[f"{a}_s{ax}"])
                     s = acc.setdefault((r["phase"], a, ax), [0, 0.0, 0.0, 0.0])
                     s[0] += 1
                     s[1] += e
@@ -65,11 +70,11 @@ def motion_table(runs, agents=("lead", "uav1")):
             for a in agents:
                 s = acc.setdefault((r["phase"], a), [0.0, 0.0, 0.0])
                 for ax in "xy":
-                    v = float(r[f"{a}_v{ax}_true"])
-                    s[0] += (float(r[f"{a}_p{ax}_est"]) - float(r[f"{a}_p{ax}_true"])) * v
-                    s[1] += (float(r[f"{a}_v{ax}_est"]) - v) * v
+                    v = cell(r[f"{a}_v{ax}_true"])
+                    s[0] += (cell(r[f"{a}_p{ax}_est"]) - cell(r[f"{a}_p{ax}_true"])) * v
+                    s[1] += (cell(r[f"{a}_v{ax}_est"]) - v) * v
                     s[2] += v * v
-                ex = float(r[f"{a}_px_est"]) - float(r[f"{a}_px_true"])
+                ex = cell(r[f"{a}_px_est"]) - cell(r[f"{a}_px_true"])
                 ends.setdefault((r["phase"], a), [ex, ex])[1] = ex
         for key, (ep, ev, vv) in acc.items():
             first, last = ends[key]
@@ -87,9 +92,9 @@ def landmark_table(dirs):
             for r in csv.DictReader(f):
                 t = per.setdefault(r["init_phase"], {"init": [[], [], []], "final": [[], [], []]})
                 for i, ax in enumerate("xyz"):
-                    truth = float(r[f"truth_{ax}"])
+                    truth = cell(r[f"truth_{ax}"])
                     for when in ("init", "final"):
-                        v = float(r[f"{when}_{ax}"])
+                        v = cell(r[f"{when}_{ax}"])
                         if math.isfinite(v):
                             t[when][i].append(v - truth)
     return per

@@ -20,6 +20,11 @@ import sys
 from pathlib import Path
 
 
+def cell(text):
+    """A CSV value; an empty field is a value wingman does not have (NaN)."""
+    return float(text) if text else float("nan")
+
+
 def load(root, variant):
     runs = []
     for d in sorted(Path(root).iterdir(), key=lambda p: (len(p.name), p.name)):
@@ -38,7 +43,7 @@ def worst_landmark(path):
     worst = 0.0
     with path.open() as f:
         for r in csv.DictReader(f):
-            d = math.dist([float(r[f"final_{a}"]) for a in "xyz"], [float(r[f"truth_{a}"]) for a in "xyz"])
+            d = math.dist([cell(r[f"final_{a}"]) for a in "xyz"], [cell(r[f"truth_{a}"]) for a in "xyz"])
             worst = max(worst, d)
     return worst
 

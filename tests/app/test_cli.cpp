@@ -186,11 +186,30 @@ TEST_F(CliTest, RunWritesCompleteResultsDirectory) {
   for (std::string tok; row >> tok;) ++cols;
   EXPECT_EQ(cols, 8);
 
-  // Running again into the results directory replaces it.
+  // Running again into the results directory is refused without --force; with it, replaces it.
+  const auto before = fs::last_write_time(out / "multi" / "metrics.json");
+  const RunResult refused = run_wingman(
+      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "single"},
+      tmp_.path());
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_THAT(refused.output, HasSubstr("--force"));
+  EXPECT_EQ(fs::last_write_time(out / "multi" / "metrics.json"), before);  // multi kept
   const RunResult again = run_wingman(
-      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"},
+      {"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi", "--force"},
       tmp_.path());
   EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_TRUE(fs::is_regular_file(out / "multi" / "metrics.json"));
+  EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
+}
+
+TEST_F(CliTest, RenderRefusesToReplaceAResultsDirectory) {
+  const fs::path out = out_dir("results");
+  ASSERT_EQ(run_wingman({"run", "scenes/smoke.yaml", "--out", out.string(), "--no-plots", "-q", "--variant", "multi"},
+                        tmp_.path()).exit_code, 0);
+  const RunResult r = run_wingman({"render", "scenes/rendered_smoke.yaml", "--out", out.string(), "--frames", "1", "-q"},
+                                  tmp_.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("already holds wingman results"));
   EXPECT_TRUE(fs::is_regular_file(out / "multi" / "metrics.json"));
   EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
 }

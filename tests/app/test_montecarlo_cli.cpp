@@ -30,7 +30,12 @@ TEST(MonteCarloCli, RunsInWorkersAggregatesAndResumes) {
   EXPECT_TRUE(fs::exists(out / "runs" / "seed3" / "multi" / "metrics.json"));
   EXPECT_TRUE(fs::exists(out / "runs" / "seed2" / "keep.txt"));  // untouched
 
-  const auto mc = nlohmann::json::parse(read_file(out / "montecarlo.json"));
+  const auto doc = nlohmann::json::parse(read_file(out / "montecarlo.json"));
+  EXPECT_EQ(doc["seeds"], nlohmann::json::array({1, 3}));
+  ASSERT_EQ(doc["failed_seeds"].size(), 1u);  // the failed run is listed with its reason
+  EXPECT_EQ(doc["failed_seeds"][0]["seed"], 2);
+  EXPECT_THAT(doc["failed_seeds"][0]["reason"].get<std::string>(), HasSubstr("not a wingman results directory"));
+  const auto& mc = doc["variants"];
   ASSERT_EQ(mc.size(), 1u);
   EXPECT_EQ(mc[0]["label"], "multi");
   EXPECT_EQ(mc[0]["runs"], 2);
@@ -60,7 +65,7 @@ TEST(MonteCarloCli, RunsInWorkersAggregatesAndResumes) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("2 of 3 runs already finished")) << r.output;
   EXPECT_THAT(r.output, HasSubstr("batches of 2 runs")) << r.output;
-  const auto resumed = nlohmann::json::parse(read_file(out / "montecarlo.json"));
+  const auto resumed = nlohmann::json::parse(read_file(out / "montecarlo.json"))["variants"];
   EXPECT_EQ(resumed[0]["runs"], 3);
   ASSERT_EQ(resumed[0]["batch_test"]["batches"].size(), 1u);
   EXPECT_EQ(resumed[0]["batch_test"]["batches"][0]["label"], "seeds 1-2");

@@ -498,11 +498,67 @@ TEST(ScenarioYaml, UavNames) {
   EXPECT_THAT(error_of("uavs:\n  - {name: a}\n  - {name: a}\n"),
               HasSubstr("scn.yaml:3:12: uavs[1].name: duplicate UAV name 'a' (first at line 2)"));
   EXPECT_THAT(error_of("uavs:\n  - {name: Uav-1}\n  - {name: b}\n"),
-              HasSubstr("uavs[0].name: UAV names must match [a-z0-9_]+, got 'Uav-1'"));
+              HasSubstr("uavs[0].name: UAV names must match [a-z0-9_]+ and be at most 64 characters, got 'Uav-1'"));
   EXPECT_THAT(error_of("uavs:\n  - {name: lead}\n  - {name: b}\n"),
               HasSubstr("uavs[0].name: 'lead' is reserved"));
   EXPECT_THAT(error_of("uavs:\n  - {sees_lead: true}\n  - {name: b}\n"),
               HasSubstr("scn.yaml:2:5: uavs[0]: missing required key 'name'"));
+  // Names become file names: a 300-character name is refused when the file is read, not when
+  // the results are written after the whole run.
+  EXPECT_THAT(error_of("uavs:\n  - {name: " + std::string(300, 'a') + "}\n"),
+              HasSubstr("scn.yaml:2:12: uavs[0].name: UAV names must match"));
+}
+
+TEST(ScenarioYaml, NamesAreShortPlainText) {
+  EXPECT_THAT(error_of("name: \"a\\xff\"\n"), HasSubstr("scn.yaml:1:7: name: the scenario's name names its "
+                                                          "results directory"));
+  EXPECT_THAT(error_of("name: \"a\xff\"\n"), HasSubstr("scn.yaml:1:7: name: not valid UTF-8 text"));
+  EXPECT_THAT(error_of("name: ../../etc\n"), HasSubstr("name: the scenario's name"));
+  EXPECT_THAT(error_of("name: " + std::string(65, 'x') + "\n"), HasSubstr("at most 64 characters"));
+  EXPECT_THAT(error_of("phases:\n  - {name: 'a b', from: 0, to: 1, config: 1}\nduration: 1\n"),
+              HasSubstr("phases[0].name: phase names must match"));
+  EXPECT_THAT(error_of("world:\n  texture: {image: \"x\xc3\"}\n"), HasSubstr("world.texture.image: not valid UTF-8"));
+}
+
+TEST(ScenarioYaml, RunSizeIsBoundedByWhatItDrives) {
+  EXPECT_THAT(error_of("duration: 0.01\nrate: 10\n"),
+              HasSubstr("scn.yaml:1:11: duration: 0.01 s at rate 10 Hz is shorter than one step (0.1 s)"));
+  EXPECT_THAT(error_of("duration: 1e308\n"), HasSubstr("scn.yaml:1:11: duration: 1e+308 s at rate 10 Hz is inf steps"));
+  EXPECT_THAT(error_of("rate: 1000\nduration: 1e6\n"),
+              HasSubstr("scn.yaml:2:11: duration: 1000000 s at rate 1000 Hz is 1e+09 steps; at most 5e+06"));
+  EXPECT_THAT(error_of("landmarks: {density: 1e6}\n"),
+              HasSubstr("scn.yaml:1:22: landmarks.density: 1000000 points/m^2"));
+  EXPECT_THAT(error_of("landmarks: {margin: 1e7}\n"), HasSubstr("landmarks.density (default): "));
+  EXPECT_THAT(error_of("lead: {initial_position: [3e9, 0, 0]}\n"),
+              HasSubstr("lead.initial_position: [3000000000, 0, 0] is farther than 1e+05 m"));
+  EXPECT_THAT(error_of("lead: {trajectory: {scale: 1e9}}\n"),
+              HasSubstr("lead.trajectory.scale: the flight spans"));
+  EXPECT_THAT(error_of("measurements: rendered\nworld: {terrain: {extent: 1e6}}\n"),
+              HasSubstr("world.terrain.extent: the terrain mesh would have 2.5e+11 vertices"));
+  std::string many = "uavs:\n";
+  for (int i = 0; i < 65; ++i) many += "  - {name: u" + std::to_string(i) + "}\n";
+  EXPECT_THAT(error_of(many), HasSubstr("scn.yaml:2:3: uavs: 65 UAVs; at most 64"));
+  // 3e6 steps of 2 agents' records fit; of 64 UAVs they would not, and the message says so.
+  std::string team = "duration: 4.9e5\nuavs:\n";
+  for (int i = 0; i < 64; ++i) team += "  - {name: u" + std::to_string(i) + "}\n";
+  EXPECT_THAT(error_of(team), HasSubstr("duration: this run would need about"));
+}
+
+std::string load_error(const std::string& path) {
+  try {
+    load_scenarios(path);
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected a ScenarioError for " << path;
+  return "";
+}
+
+TEST(ScenarioFile, OversizedOrBinaryFilesAreRefusedBeforeParsing) {
+  EXPECT_THAT(load_error("/dev/zero"), HasSubstr("/dev/zero: larger than 4 MiB"));
+  const std::string nul = testing::TempDir() + "/nul.yaml";
+  std::ofstream(nul) << std::string("name: a\0b\n", 10);
+  EXPECT_THAT(load_error(nul), HasSubstr("nul.yaml: holds a NUL byte at offset 7"));
 }
 
 TEST(ScenarioYaml, DuplicateKeys) {

@@ -166,8 +166,8 @@ TEST(MonteCarlo, PhaseMeanIntervalAndConsistentFilterReferenceFromRuns) {
   EXPECT_NE(table.find("mean NEES [95% CI]"), std::string::npos) << table;
   write_monte_carlo({m}, tmp.path);
   const auto j = nlohmann::json::parse(std::ifstream(tmp.path / "montecarlo.json"));
-  EXPECT_TRUE(j[0]["phases"][0].contains("nees_mean_ci95"));
-  EXPECT_TRUE(j[0]["phases"][0]["consistent_filter"]["median_fraction_inside"].is_number());
+  EXPECT_TRUE(j["variants"][0]["phases"][0].contains("nees_mean_ci95"));
+  EXPECT_TRUE(j["variants"][0]["phases"][0]["consistent_filter"]["median_fraction_inside"].is_number());
 }
 
 TEST(MonteCarlo, PoissonBinomialCdf) {
@@ -216,8 +216,8 @@ TEST(MonteCarlo, BatchesEachAgainstTheirOwnBounds) {
   EXPECT_NE(table.find("batches of 2 runs"), std::string::npos) << table;
   write_monte_carlo({m}, tmp.path);
   const auto j = nlohmann::json::parse(std::ifstream(tmp.path / "montecarlo.json"));
-  EXPECT_EQ(j[0]["batch_test"]["batches"].size(), 3u);
-  EXPECT_EQ(j[0]["batch_test"]["passed"].get<int>(), passed);
+  EXPECT_EQ(j["variants"][0]["batch_test"]["batches"].size(), 3u);
+  EXPECT_EQ(j["variants"][0]["batch_test"]["passed"].get<int>(), passed);
 
   EXPECT_THROW(test_batches("multi", {dirs[0]}, 2), std::invalid_argument);
 }

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <fstream>
 #include <string>
 
@@ -48,7 +51,79 @@ TEST(ResultsDir, CommitMovesIntoPlaceWithMarker) {
   EXPECT_TRUE(ResultsDir::is_results_dir(final_dir));
 }
 
-TEST(ResultsDir, CommitReplacesPreviousResults) {
+TEST(ResultsDir, ExistingResultsAreRefusedWithoutForce) {
+  test::TempDir tmp;
+  const fs::path final_dir = tmp.path() / "run";
+  {
+    ResultsDir rd(final_dir);
+    fs::create_directories(rd.staging() / "multi");
+    touch(rd.staging() / "multi" / "metrics.json");
+    rd.commit();
+  }
+  try {
+    ResultsDir rd(final_dir);
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos) << e.what();
+  }
+  try {  // a dataset command names what the directory holds
+    ResultsDir rd(final_dir, {"dataset", false});
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("already holds wingman results"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::exists(final_dir / "multi" / "metrics.json"));
+  EXPECT_EQ(ResultsDir::kind_of(final_dir), "results");
+  // Appearing during the run is refused at commit, and the existing one is kept.
+  const fs::path later = tmp.path() / "later";
+  {
+    ResultsDir rd(later, {"dataset", false});
+    {
+      ResultsDir other(later);
+      touch(other.staging() / "first.txt");
+      other.commit();
+    }
+    EXPECT_THROW(rd.commit(), std::runtime_error);
+  }
+  EXPECT_TRUE(fs::exists(later / "first.txt"));
+}
+
+TEST(ResultsDir, StagingLeftByAKilledProcessIsRemovedAndNamed) {
+  test::TempDir tmp;
+  const fs::path final_dir = tmp.path() / "run";
+  const pid_t dead = fork();
+  if (dead == 0) _exit(0);
+  waitpid(dead, nullptr, 0);
+  const fs::path stale = tmp.path() / ("run.partial-" + std::to_string(dead));
+  const fs::path live = tmp.path() / ("run.partial-" + std::to_string(getppid()));
+  const fs::path unrelated = tmp.path() / "runs.partial-1";
+  for (const auto& d : {stale, live, unrelated}) fs::create_directories(d), touch(d / "metrics.json");
+  ResultsDir rd(final_dir);
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_TRUE(fs::exists(live));       // its process is still running
+  EXPECT_TRUE(fs::exists(unrelated));  // another target's
+  ASSERT_EQ(rd.notes().size(), 2u);
+  std::string all = rd.notes()[0] + "\n" + rd.notes()[1];
+  EXPECT_NE(all.find("removed " + stale.string()), std::string::npos) << all;
+  EXPECT_NE(all.find("still running"), std::string::npos) << all;
+}
+
+TEST(ResultsDir, PreviousResultMovedAsideByAKilledProcessIsRestored) {
+  test::TempDir tmp;
+  const fs::path final_dir = tmp.path() / "run";
+  const pid_t dead = fork();
+  if (dead == 0) _exit(0);
+  waitpid(dead, nullptr, 0);
+  const fs::path old = tmp.path() / ("run.old-" + std::to_string(dead));
+  fs::create_directories(old);
+  touch(old / ResultsDir::kMarker, "wingman results directory\n");
+  touch(old / "metrics.json");
+  EXPECT_THROW(ResultsDir rd(final_dir), std::runtime_error);  // restored, so now it exists
+  EXPECT_TRUE(fs::exists(final_dir / "metrics.json"));
+  EXPECT_FALSE(fs::exists(old));
+}
+
+TEST(ResultsDir, ForceReplacesPreviousResults) {
   test::TempDir tmp;
   const fs::path final_dir = tmp.path() / "run";
   {
@@ -57,7 +132,7 @@ TEST(ResultsDir, CommitReplacesPreviousResults) {
     rd.commit();
   }
   {
-    ResultsDir rd(final_dir);
+    ResultsDir rd(final_dir, {"results", true});
     touch(rd.staging() / "new.txt");
     rd.commit();
   }
@@ -83,10 +158,10 @@ TEST(ResultsDir, RefusesToReplaceForeignDirectory) {
   }
   EXPECT_TRUE(fs::exists(final_dir / "thesis.tex"));
 
-  // Also when the foreign directory appears during the run.
+  // Also when the foreign directory appears during the run, even with force.
   const fs::path later = tmp.path() / "later";
   {
-    ResultsDir rd(later);
+    ResultsDir rd(later, {"results", true});
     fs::create_directories(later);
     touch(later / "data.bin");
     EXPECT_THROW(rd.commit(), std::runtime_error);

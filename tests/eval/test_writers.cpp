@@ -178,8 +178,8 @@ TEST(Writers, StepsCsvHeaderAndValues) {
       EXPECT_EQ(std::stod(row[col("uav1_nees_v")]), run.steps[k].agents[1].nees_v);
     }
   }
-  EXPECT_EQ(split(lines[6], ',')[col("nees")], "nan");
-  EXPECT_EQ(split(lines[6], ',')[col("uav1_nees_v")], "nan");
+  EXPECT_EQ(split(lines[6], ',')[col("nees")], "");  // no value: an empty field, never "nan"
+  EXPECT_EQ(split(lines[6], ',')[col("uav1_nees_v")], "");
 }
 
 TEST(Writers, LandmarksCsv) {
@@ -197,7 +197,7 @@ TEST(Writers, LandmarksCsv) {
   EXPECT_EQ(second[14], "0");            // init_phase
   EXPECT_EQ(std::stod(second[15]), 15.0);
   EXPECT_EQ(second[16], "inverse_depth");
-  EXPECT_EQ(split(lines[1], ',')[15], "nan");
+  EXPECT_EQ(split(lines[1], ',')[15], "");
 }
 
 TEST(Writers, CorrespondencesCsvOnlyWhenRecorded) {

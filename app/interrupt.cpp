@@ -1,0 +1,45 @@
+#include "app/interrupt.hpp"
+
+#include <signal.h>
+
+#include <atomic>
+#include <string>
+
+namespace wingman::app {
+namespace {
+
+std::atomic<int> g_signal{0};
+extern "C" void on_interrupt(int sig) { g_signal = sig; }
+
+struct sigaction g_old_int {}, g_old_term {};
+
+const char* signal_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal"; }
+
+}  // namespace
+
+Interrupted::Interrupted(int sig)
+    : std::runtime_error(std::string("interrupted by ") + signal_name(sig) +
+                         ": stopped, nothing written (the staging directory is removed)"),
+      signal(sig) {}
+
+InterruptGuard::InterruptGuard() {
+  g_signal = 0;
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &g_old_int);
+  sigaction(SIGTERM, &sa, &g_old_term);
+}
+
+InterruptGuard::~InterruptGuard() {
+  sigaction(SIGINT, &g_old_int, nullptr);
+  sigaction(SIGTERM, &g_old_term, nullptr);
+}
+
+int interrupt_signal() { return g_signal; }
+
+void throw_if_interrupted() {
+  if (const int sig = g_signal) throw Interrupted(sig);
+}
+
+}  // namespace wingman::app

@@ -1,0 +1,96 @@
+#include "sim/budget.hpp"
+
+#include <fmt/core.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/truth.hpp"
+
+namespace wingman::sim {
+namespace {
+
+// Bytes per unit, measured as orders of magnitude (docs/reliability.md): a step's records with
+// one agent's share, a synthetic landmark, a terrain vertex (CPU mesh and its GL copy), a pixel
+// of a rendered frame (colour, depth, gray, GL buffers, the prefetched next frame).
+constexpr double kStepBytes = 600, kAgentStepBytes = 500, kLandmarkBytes = 96, kVertexBytes = 96,
+                 kPixelBytes = 48;
+// Wall time: a synthetic step, and a rendered camera frame (render + detect + match), 2 cores.
+constexpr double kSyntheticStepSeconds = 2e-3, kRenderedFrameSeconds = 0.08;
+
+// The flight's horizontal bounding box, sampled at most 10 000 times (the analytic trajectory
+// plus each agent's offset from the lead), so estimating never costs what it guards against.
+Eigen::Vector4d sampled_extent(const Scenario& s) {
+  Eigen::Vector4d box(INFINITY, INFINITY, -INFINITY, -INFINITY);
+  const int n = 10000;
+  const Eigen::Vector3d origin = nominal_motion(s.lead.trajectory, 0).position;
+  for (int k = 0; k <= n; ++k) {
+    const Eigen::Vector3d p = nominal_motion(s.lead.trajectory, s.duration * k / n).position - origin;
+    auto grow = [&](const Eigen::Vector3d& start) {
+      box(0) = std::min(box(0), p.x() + start.x());
+      box(1) = std::min(box(1), p.y() + start.y());
+      box(2) = std::max(box(2), p.x() + start.x());
+      box(3) = std::max(box(3), p.y() + start.y());
+    };
+    grow(s.lead.initial_position);
+    for (const auto& u : s.uavs) grow(u.initial_position);
+  }
+  return box;
+}
+
+}  // namespace
+
+RunEstimate estimate_run(const Scenario& s) {
+  RunEstimate e;
+  e.steps = s.duration * s.rate;
+  const double agents = 1.0 + static_cast<double>(s.uavs.size());
+  const Eigen::Vector4d box = sampled_extent(s);
+  const double wx = box(2) - box(0), wy = box(3) - box(1);
+  e.extent_m = std::max(wx, wy);
+  const double m = s.field.margin;
+  e.landmarks = s.field.density * (wx + 2 * m) * (wy + 2 * m);
+  e.bytes = (e.steps + 1) * (kStepBytes + agents * kAgentStepBytes);
+  e.seconds = e.steps * kSyntheticStepSeconds;
+  if (s.measurements == MeasurementMode::Rendered) {
+    const auto& t = s.world.terrain;
+    const double side = t.extent > 0 ? t.extent : e.extent_m + 2 * t.margin;
+    e.terrain_vertices = std::pow(side / t.resolution + 2, 2);
+    for (const auto& u : s.uavs) e.pixels += double(u.camera.width) * u.camera.height;
+    const double texture = double(s.world.texture.size) * s.world.texture.size * 4 * 4.0 / 3;
+    e.bytes += e.terrain_vertices * kVertexBytes + e.pixels * kPixelBytes + texture +
+               s.duration / 0.1 * 48;  // the terrain's samples of a ground lead's path
+    e.seconds += e.steps * static_cast<double>(s.uavs.size()) * kRenderedFrameSeconds;
+  } else {
+    e.bytes += e.landmarks * kLandmarkBytes;
+  }
+  return e;
+}
+
+double memory_available() {
+  const double pages = static_cast<double>(::sysconf(_SC_PHYS_PAGES));
+  const double page = static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  double bytes = pages > 0 && page > 0 ? pages * page : 8.0 * (1ull << 30);
+  struct rlimit rl {};
+  if (::getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY)
+    bytes = std::min(bytes, static_cast<double>(rl.rlim_cur));
+  return bytes * RunLimits::kMemoryFraction;
+}
+
+std::string bytes_text(double b) {
+  if (!std::isfinite(b)) return fmt::format("{} bytes", b);
+  if (b >= 1024.0 * 1024 * 1024 * 1024) return fmt::format("{:.3g} TiB", b / (1024.0 * 1024 * 1024 * 1024));
+  if (b >= 1024.0 * 1024 * 1024) return fmt::format("{:.3g} GiB", b / (1024.0 * 1024 * 1024));
+  return fmt::format("{:.3g} MiB", b / (1024.0 * 1024));
+}
+
+std::string duration_text(double s) {
+  if (!std::isfinite(s)) return fmt::format("{} s", s);
+  if (s >= 86400 * 365.0) return fmt::format("{:.3g} years", s / (86400 * 365.0));
+  if (s >= 86400) return fmt::format("{:.3g} days", s / 86400);
+  if (s >= 3600) return fmt::format("{:.3g} h", s / 3600);
+  return fmt::format("{:.3g} min", s / 60);
+}
+
+}  // namespace wingman::sim
