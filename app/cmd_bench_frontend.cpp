@@ -42,7 +42,7 @@ int bench_command(const BenchOptions& o, const std::string& variant) {
       throw UsageError(e.what());
     }
   }
-  Replay replay = load_replay(o.dataset, variant);
+  Replay replay = load_replay(o.dataset, variant, o.quiet);
   apply_step_limit(o.limit, replay.scenario);
   const RunConfig& scn = replay.scenario;
   // Each detector with the rest of the scenario's frontend section (bucketing, thresholds).

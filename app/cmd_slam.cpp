@@ -42,7 +42,7 @@ struct SlamOptions {
 
 // One variant's replay into `out` (or, with several variants, out/<variant>).
 int slam_command(const SlamOptions& o, const std::string& variant) {
-  Replay replay = load_replay(o.dataset, variant);
+  Replay replay = load_replay(o.dataset, variant, o.quiet);
   apply_step_limit(o.limit, replay.scenario);
   const datasets::Dataset& ds = replay.dataset;
   const RunConfig& scn = replay.scenario;

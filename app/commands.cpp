@@ -11,6 +11,7 @@
 #include "app/interrupt.hpp"
 #include "app/subcommand.hpp"
 #include "app/version.hpp"
+#include "datasets/dataset.hpp"
 #include "sim/scenario.hpp"
 
 namespace wingman::app {
@@ -56,6 +57,9 @@ int run_cli(int argc, char** argv) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 2;
   } catch (const UsageError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 2;
+  } catch (const datasets::DatasetError& e) {  // a frame or file of a dataset that is bad input
     fmt::print(stderr, "error: {}\n", e.what());
     return 2;
   } catch (const std::exception& e) {

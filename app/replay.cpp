@@ -3,13 +3,77 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <cmath>
 
+#include "app/progress.hpp"
 #include "app/subcommand.hpp"
 #include "app/variants.hpp"
 
 namespace wingman::app {
+namespace {
 
-Replay load_replay(const std::string& dir, const std::string& variant) {
+bool same(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max({1.0, std::abs(a), std::abs(b)}); }
+
+// One camera of the dataset against the scenario's UAV it belongs to.
+void check_camera(const datasets::AgentData& a, const sim::UavSpec& u, double scn_rate,
+                  const std::filesystem::path& ds_root, const std::filesystem::path& scn_path) {
+  const auto file = (ds_root / a.name / "cam0" / "sensor.yaml").string();
+  if (!a.camera) throw UsageError(fmt::format("{}: missing: the scenario's UAV '{}' has a camera", file, u.name));
+  const geometry::PinholeCamera& d = a.camera->camera;
+  const geometry::PinholeCamera s = u.camera.camera();
+  const auto& dd = d.distortion();
+  const auto& sd = s.distortion();
+  const bool ok = d.width() == s.width() && d.height() == s.height() && same(d.fx(), s.fx()) &&
+                  same(d.fy(), s.fy()) && same(d.cx(), s.cx()) && same(d.cy(), s.cy()) && same(dd.k1, sd.k1) &&
+                  same(dd.k2, sd.k2) && same(dd.p1, sd.p1) && same(dd.p2, sd.p2) && same(dd.k3, sd.k3);
+  if (!(std::abs(a.camera->rate - scn_rate) <= 1e-9 * scn_rate))
+    throw UsageError(fmt::format("{}: rate_hz {} differs from the scenario's {} Hz", file, a.camera->rate, scn_rate));
+  if (!ok)
+    throw UsageError(fmt::format(
+        "{}: the camera ({}x{}, fx {} fy {} cx {} cy {}) is not the one {} gives uav '{}' ({}x{}, fx {} fy {} cx {} "
+        "cy {}, or its distortion differs): the frames would be read with the wrong model",
+        file, d.width(), d.height(), d.fx(), d.fy(), d.cx(), d.cy(), scn_path.string(), u.name, s.width(), s.height(),
+        s.fx(), s.fy(), s.cx(), s.cy()));
+  for (std::size_t k = 0; k < a.frames.size(); ++k)
+    if (a.frames[k] != datasets::step_ns(static_cast<int>(k), a.camera->rate))
+      throw UsageError(fmt::format("{}: frame {} has time stamp {} ns; at {} Hz it would be {} ns",
+                                   (ds_root / a.name / "cam0" / "data.csv").string(), k + 1, a.frames[k],
+                                   a.camera->rate, datasets::step_ns(static_cast<int>(k), a.camera->rate)));
+}
+
+// The dataset and its scenario describe the same run: the same rate, an agent with the same
+// camera for every UAV, the lead's ground truth. A dataset that contradicts its scenario would
+// change the results without a word.
+void check_against_scenario(const datasets::Dataset& ds, const RunConfig& scn, const std::filesystem::path& scn_path) {
+  const auto yf = (ds.root / "dataset.yaml").string();
+  if (!(std::abs(ds.info.rate - scn.rate) <= 1e-9 * scn.rate))
+    throw UsageError(fmt::format("{}: rate_hz {} differs from the rate {} Hz of {}", yf, ds.info.rate, scn.rate,
+                                 scn_path.string()));
+  auto find = [&](const std::string& name) -> const datasets::AgentData* {
+    for (const auto& a : ds.agents)
+      if (a.name == name) return &a;
+    return nullptr;
+  };
+  if (!find("lead")) throw UsageError(fmt::format("{}: agents: no 'lead' (its ground truth is needed)", yf));
+  for (const auto& u : scn.uavs) {
+    const datasets::AgentData* a = find(u.name);
+    if (!a)
+      throw UsageError(fmt::format("{}: agents: no '{}', a UAV of {} ({})", yf, u.name, scn_path.string(),
+                                   scn.uav_names()));
+    check_camera(*a, u, scn.rate, ds.root, scn_path);
+    if (a->frames.size() != ds.agents.front().frames.size() && a->camera && ds.agents.front().camera)
+      throw UsageError(fmt::format("{}: {} has {} frames, {} has {}", yf, a->name, a->frames.size(),
+                                   ds.agents.front().name, ds.agents.front().frames.size()));
+    if (a->groundtruth.size() < a->frames.size())
+      throw UsageError(fmt::format("{}: {} poses for {} frames",
+                                   (ds.root / a->name / "groundtruth" / "data.csv").string(), a->groundtruth.size(),
+                                   a->frames.size()));
+  }
+}
+
+}  // namespace
+
+Replay load_replay(const std::string& dir, const std::string& variant, bool quiet) {
   Replay r;
   try {
     r.dataset = datasets::read_dataset(dir);
@@ -25,11 +89,20 @@ Replay load_replay(const std::string& dir, const std::string& variant) {
   RunConfig& scn = r.scenario;
   scn.seed = r.dataset.info.seed;
   scn.measurements = sim::MeasurementMode::Rendered;
+  check_against_scenario(r.dataset, scn, r.scenario_path);
   // A shortened dataset (render --frames/--duration) replays what it has.
-  const auto& first = r.dataset.agent(scn.uavs.front().name);
-  const int frames = static_cast<int>(first.frames.size());
+  const int frames = static_cast<int>(r.dataset.agent(scn.uavs.front().name).frames.size());
   if (frames < 2) throw UsageError(fmt::format("{}: fewer than 2 frames to replay", dir));
   scn.duration = std::min(scn.duration, (frames - 1) / scn.rate);
+  // Every frame is checked before the first step, so a damaged one is bad input now, not an
+  // error an hour into the replay.
+  ProgressLine progress(fmt::format("[verify {}]", dir), quiet);
+  try {
+    datasets::verify_frames(r.dataset, [&](int k, int n) { progress.update(k, n, "frames"); });
+  } catch (const datasets::DatasetError& e) {
+    throw UsageError(e.what());
+  }
+  progress.finish();
   return r;
 }
 

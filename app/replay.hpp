@@ -17,8 +17,10 @@ struct Replay {
   std::filesystem::path scenario_path;  // DIR/scenario.yaml
 };
 
-// `variant` empty: the one the dataset was rendered with (else the first). Throws UsageError
-// naming the file for a dataset or scenario that cannot be used.
-Replay load_replay(const std::string& dir, const std::string& variant);
+// `variant` empty: the one the dataset was rendered with (else the first). Checks the dataset
+// against its scenario (rate, cameras, agents) and verifies every frame (checksums.csv) before
+// returning, with a progress line unless `quiet`. Throws UsageError naming the file for a
+// dataset or scenario that cannot be used.
+Replay load_replay(const std::string& dir, const std::string& variant, bool quiet = false);
 
 }  // namespace wingman::app

@@ -13,8 +13,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <stdexcept>
@@ -94,6 +96,15 @@ struct Dataset {
   cv::Mat load_depth(const std::string& agent, std::int64_t t_ns) const;
 };
 
+// checksums.csv at the dataset's root: every frame's size and CRC-32 as `wingman render` wrote it,
+// so that a replay verifies every frame before its first step without decoding one.
+inline constexpr const char* kChecksumsFile = "checksums.csv";
+struct FrameChecksum {
+  std::uint64_t bytes = 0;
+  std::uint32_t crc32 = 0;
+};
+std::uint32_t crc32_of(const unsigned char* data, std::size_t size);
+
 // Time stamp of step k at a rate, in integer nanoseconds.
 std::int64_t step_ns(int k, double rate);
 
@@ -128,12 +139,18 @@ class DatasetWriter {
   std::filesystem::path dir_;
   DatasetInfo info_;
   std::vector<AgentData> agents_;
+  std::mutex checksums_mutex_;
+  std::map<std::string, FrameChecksum> checksums_;  // path relative to the dataset's root
   std::unique_ptr<Encoder> encoder_;
 };
 
 // Loads and validates a dataset directory: dataset.yaml with a known format version, every
-// agent's CSVs, every listed frame present with the size sensor.yaml gives (read from the PNG
-// header, so this is fast). Throws DatasetError naming the file.
+// agent's CSVs (finite values in range, increasing time stamps), every sensor.yaml (positive
+// intrinsics, a rotation matrix, a positive rate), every listed frame present with the size
+// sensor.yaml gives (read from the PNG header, so this is fast). Throws DatasetError naming the file.
 Dataset read_dataset(const std::filesystem::path& dir);
+// Every frame's bytes against checksums.csv (size and CRC-32), or, for a dataset without one,
+// every frame decoded. Throws DatasetError naming the first bad frame. `progress(done, total)`.
+void verify_frames(const Dataset& ds, const std::function<void(int, int)>& progress = {});
 
 }  // namespace wingman::datasets

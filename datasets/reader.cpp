@@ -1,9 +1,14 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/LU>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <map>
 #include <sstream>
 
 #include "datasets/dataset.hpp"
@@ -18,9 +23,22 @@ namespace {
   throw DatasetError(fmt::format("{}: {}", file.string(), what));
 }
 
+// Files are size-checked before they are read: a YAML file is a few hundred bytes, a CSV at most
+// one row per step of the longest run a scenario may describe.
+constexpr std::uintmax_t kMaxYamlBytes = 1u << 20, kMaxCsvBytes = std::uintmax_t{2} << 30;
+// Positions, sensor values: anything farther than this from the origin is corrupt.
+constexpr double kMaxMagnitude = 1e7;
+
+void check_size(const fs::path& p, std::uintmax_t limit) {
+  std::error_code ec;
+  const auto size = fs::file_size(p, ec);
+  if (!ec && size > limit) fail(p, fmt::format("{} bytes; at most {} for this file", size, limit));
+}
+
 YAML::Node load_yaml(const fs::path& p) {
   std::error_code ec;
   if (!fs::is_regular_file(p, ec)) fail(p, "missing");
+  check_size(p, kMaxYamlBytes);
   try {
     return YAML::LoadFile(p.string());
   } catch (const YAML::Exception& e) {
@@ -49,6 +67,7 @@ std::vector<double> numbers(const YAML::Node& n, const fs::path& file, const cha
 std::vector<std::vector<std::string>> read_csv(const fs::path& p, std::size_t columns) {
   std::ifstream in(p);
   if (!in) fail(p, "missing");
+  check_size(p, kMaxCsvBytes);
   std::vector<std::vector<std::string>> rows;
   std::string line;
   int n = 0;
@@ -66,14 +85,26 @@ std::vector<std::vector<std::string>> read_csv(const fs::path& p, std::size_t co
   return rows;
 }
 
+// A finite number of magnitude at most kMaxMagnitude: NaN, inf or 1e308 in a sensor row is a
+// corrupt file, never a sample to drop silently.
 double num(const std::string& s, const fs::path& p, std::size_t row) {
+  double v = 0;
   try {
     std::size_t used = 0;
-    const double v = std::stod(s, &used);
-    if (used == s.size()) return v;
+    v = std::stod(s, &used);
+    if (used != s.size()) fail(p, fmt::format("data row {}: '{}' is not a number", row + 1, s));
   } catch (const std::exception&) {
+    fail(p, fmt::format("data row {}: '{}' is not a number", row + 1, s));
   }
-  fail(p, fmt::format("data row {}: '{}' is not a number", row + 1, s));
+  if (!std::isfinite(v) || std::abs(v) > kMaxMagnitude)
+    fail(p, fmt::format("data row {}: {} is not a finite value of magnitude at most {:g}", row + 1, s,
+                        kMaxMagnitude));
+  return v;
+}
+
+// Time stamps increase down every CSV.
+void check_increasing(std::int64_t t, std::int64_t previous, bool first, const fs::path& p, std::size_t row) {
+  if (!first && t <= previous) fail(p, fmt::format("data row {}: time stamps must increase", row + 1));
 }
 
 std::int64_t stamp(const std::string& s, const fs::path& p, std::size_t row) {
@@ -120,13 +151,26 @@ CameraInfo read_camera(const fs::path& file, double rate_fallback) {
   const auto d = numbers(n, file, "distortion_coefficients", 5);
   const auto r = numbers(n, file, "R_CW", 9);
   const auto o = numbers(n, file, "offset", 3);
-  if (res[0] < 1 || res[1] < 1) fail(file, "resolution must be positive");
+  if (!(res[0] >= 1 && res[0] <= 16384 && res[1] >= 1 && res[1] <= 16384) || res[0] != std::floor(res[0]) ||
+      res[1] != std::floor(res[1]))
+    fail(file, fmt::format("resolution [{}, {}] must be whole numbers of pixels from 1 to 16384", res[0], res[1]));
+  if (!(k[0] > 0 && k[1] > 0 && std::isfinite(k[0]) && std::isfinite(k[1]) && std::isfinite(k[2]) &&
+        std::isfinite(k[3])))
+    fail(file, fmt::format("intrinsics [{}, {}, {}, {}]: fx and fy must be positive, all finite", k[0], k[1],
+                           k[2], k[3]));
+  for (const auto& [key, v] : {std::pair{"distortion_coefficients", d}, std::pair{"offset", o}})
+    for (double x : v)
+      if (!std::isfinite(x) || std::abs(x) > kMaxMagnitude) fail(file, fmt::format("{}: {} is not finite", key, x));
   CameraInfo c;
   c.camera = geometry::PinholeCamera(k[0], k[1], k[2], k[3], static_cast<int>(res[0]),
                                      static_cast<int>(res[1]), {d[0], d[1], d[2], d[3], d[4]});
   for (int i = 0; i < 9; ++i) c.R_CW(i / 3, i % 3) = r[i];
+  const double orth = (c.R_CW * c.R_CW.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(orth < 1e-6) || !(std::abs(c.R_CW.determinant() - 1) < 1e-6))
+    fail(file, "R_CW is not a rotation matrix (R R^T = I and det R = 1, to 1e-6)");
   c.offset = {o[0], o[1], o[2]};
   c.rate = n["rate_hz"] ? get<double>(n, file, "rate_hz") : rate_fallback;
+  if (!(c.rate > 0 && c.rate <= 1000)) fail(file, fmt::format("rate_hz must be in (0, 1000], got {}", c.rate));
   c.channels = n["channels"] ? get<int>(n, file, "channels") : 3;
   if (c.channels != 1 && c.channels != 3) fail(file, fmt::format("channels must be 1 or 3, got {}", c.channels));
   return c;
@@ -163,8 +207,11 @@ std::vector<PoseSample> read_poses(const fs::path& csv, bool velocity) {
     const auto& r = rows[i];
     PoseSample s;
     s.t_ns = stamp(r[0], csv, i);
+    check_increasing(s.t_ns, out.empty() ? 0 : out.back().t_ns, out.empty(), csv, i);
     s.p = {num(r[1], csv, i), num(r[2], csv, i), num(r[3], csv, i)};
     s.q_xyzw = {num(r[5], csv, i), num(r[6], csv, i), num(r[7], csv, i), num(r[4], csv, i)};
+    if (std::abs(s.q_xyzw.norm() - 1) > 1e-3)
+      fail(csv, fmt::format("data row {}: the quaternion has norm {}, not 1", i + 1, s.q_xyzw.norm()));
     if (velocity) s.v = {num(r[8], csv, i), num(r[9], csv, i), num(r[10], csv, i)};
     out.push_back(s);
   }
@@ -174,8 +221,26 @@ std::vector<PoseSample> read_poses(const fs::path& csv, bool velocity) {
 std::vector<ScalarSample> read_scalars(const fs::path& csv) {
   std::vector<ScalarSample> out;
   const auto rows = read_csv(csv, 2);
-  for (std::size_t i = 0; i < rows.size(); ++i) out.push_back({stamp(rows[i][0], csv, i), num(rows[i][1], csv, i)});
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::int64_t t = stamp(rows[i][0], csv, i);
+    check_increasing(t, out.empty() ? 0 : out.back().t_ns, out.empty(), csv, i);
+    out.push_back({t, num(rows[i][1], csv, i)});
+  }
   return out;
+}
+
+// Agent names are folder names: plain, so that none reaches outside the dataset, and unique.
+void check_agent_names(const std::vector<std::string>& names, const fs::path& yf) {
+  if (names.empty()) fail(yf, "agents: the list is empty");
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const std::string& n = names[i];
+    const bool plain = !n.empty() && n.size() <= 64 && std::all_of(n.begin(), n.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+    });
+    if (!plain) fail(yf, fmt::format("agents[{}]: '{}' is not an agent name ([a-z0-9_]+, at most 64)", i, n));
+    if (std::find(names.begin(), names.begin() + static_cast<long>(i), n) != names.begin() + static_cast<long>(i))
+      fail(yf, fmt::format("agents[{}]: '{}' is listed twice", i, n));
+  }
 }
 
 }  // namespace
@@ -230,9 +295,13 @@ Dataset read_dataset(const fs::path& dir) {
   ds.info.seed = get<std::uint64_t>(y, yf, "seed");
   ds.info.software_version = get<std::string>(y, yf, "software_version");
   ds.info.rate = get<double>(y, yf, "rate_hz");
+  if (!(ds.info.rate > 0 && ds.info.rate <= 1000))
+    fail(yf, fmt::format("rate_hz must be in (0, 1000], got {}", ds.info.rate));
   ds.info.frames = get<int>(y, yf, "frames");
+  if (ds.info.frames < 0) fail(yf, fmt::format("frames must be >= 0, got {}", ds.info.frames));
   ds.info.renderer = y["renderer"] ? get<std::string>(y, yf, "renderer") : "";
   ds.info.agents = get<std::vector<std::string>>(y, yf, "agents");
+  check_agent_names(ds.info.agents, yf);
   for (const auto& name : ds.info.agents) {
     AgentData a;
     a.name = name;
@@ -256,9 +325,11 @@ Dataset read_dataset(const fs::path& dir) {
     if (fs::exists(ad / "gps0", ec)) {
       const fs::path csv = ad / "gps0" / "data.csv";
       const auto rows = read_csv(csv, 4);
-      for (std::size_t i = 0; i < rows.size(); ++i)
-        a.gps.push_back({stamp(rows[i][0], csv, i),
-                         {num(rows[i][1], csv, i), num(rows[i][2], csv, i), num(rows[i][3], csv, i)}});
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        const std::int64_t t = stamp(rows[i][0], csv, i);
+        check_increasing(t, a.gps.empty() ? 0 : a.gps.back().t_ns, a.gps.empty(), csv, i);
+        a.gps.push_back({t, {num(rows[i][1], csv, i), num(rows[i][2], csv, i), num(rows[i][3], csv, i)}});
+      }
     }
     if (fs::exists(ad / "altimeter0", ec)) a.altimeter = read_scalars(ad / "altimeter0" / "data.csv");
     if (fs::exists(ad / "range0", ec)) a.range = read_scalars(ad / "range0" / "data.csv");
@@ -266,6 +337,73 @@ Dataset read_dataset(const fs::path& dir) {
     ds.agents.push_back(std::move(a));
   }
   return ds;
+}
+
+}  // namespace wingman::datasets
+
+namespace wingman::datasets {
+namespace {
+
+std::map<std::string, FrameChecksum> read_checksums(const fs::path& csv) {
+  std::map<std::string, FrameChecksum> out;
+  const auto rows = read_csv(csv, 3);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    FrameChecksum c;
+    try {
+      std::size_t used = 0;
+      c.bytes = std::stoull(rows[i][1], &used);
+      if (used != rows[i][1].size()) throw std::invalid_argument("bytes");
+      c.crc32 = static_cast<std::uint32_t>(std::stoul(rows[i][2], &used, 16));
+      if (used != rows[i][2].size() || rows[i][2].size() > 8) throw std::invalid_argument("crc32");
+    } catch (const std::exception&) {
+      fail(csv, fmt::format("data row {}: expected file,bytes,crc32 (hex)", i + 1));
+    }
+    out[rows[i][0]] = c;
+  }
+  return out;
+}
+
+void verify_checksum(const fs::path& file, const FrameChecksum& want, std::vector<unsigned char>& buf) {
+  std::error_code ec;
+  const auto size = fs::file_size(file, ec);
+  if (ec) fail(file, "missing frame");
+  if (size != want.bytes)
+    fail(file, fmt::format("{} bytes, checksums.csv says {}: the frame is damaged or was replaced", size, want.bytes));
+  buf.resize(static_cast<std::size_t>(size));
+  std::ifstream in(file, std::ios::binary);
+  in.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
+  if (!in) fail(file, "cannot read the frame");
+  const std::uint32_t crc = crc32_of(buf.data(), buf.size());
+  if (crc != want.crc32)
+    fail(file, fmt::format("CRC-32 {:08x}, checksums.csv says {:08x}: the frame is damaged", crc, want.crc32));
+}
+
+}  // namespace
+
+void verify_frames(const Dataset& ds, const std::function<void(int, int)>& progress) {
+  const fs::path csv = ds.root / kChecksumsFile;
+  std::error_code ec;
+  const bool sums = fs::is_regular_file(csv, ec);
+  const auto checksums = sums ? read_checksums(csv) : std::map<std::string, FrameChecksum>{};
+  int total = 0, done = 0;
+  for (const auto& a : ds.agents) total += 2 * static_cast<int>(a.frames.size());
+  std::vector<unsigned char> buf;
+  for (const auto& a : ds.agents) {
+    for (const std::int64_t t : a.frames) {
+      for (const bool depth : {false, true}) {
+        const fs::path file = depth ? ds.depth_path(a.name, t) : ds.image_path(a.name, t);
+        if (sums) {
+          const std::string rel = fmt::format("{}/{}/data/{}.png", a.name, depth ? "depth0" : "cam0", t);
+          const auto it = checksums.find(rel);
+          if (it == checksums.end()) fail(file, fmt::format("not listed in {}", csv.string()));
+          verify_checksum(file, it->second, buf);
+        } else if (cv::imread(file.string(), cv::IMREAD_UNCHANGED).empty()) {
+          fail(file, "cannot decode the frame (the dataset has no checksums.csv; every frame was decoded)");
+        }
+        if (progress) progress(++done, total);
+      }
+    }
+  }
 }
 
 }  // namespace wingman::datasets

@@ -8,16 +8,29 @@
 #include <deque>
 #include <exception>
 #include <functional>
+#include <fstream>
 #include <mutex>
 #include <thread>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <zlib.h>
 
 #include "datasets/dataset.hpp"
 
 namespace fs = std::filesystem;
 
 namespace wingman::datasets {
+
+std::uint32_t crc32_of(const unsigned char* data, std::size_t size) {
+  uLong crc = ::crc32(0L, Z_NULL, 0);
+  while (size > 0) {  // zlib takes uInt lengths
+    const uInt n = static_cast<uInt>(std::min<std::size_t>(size, 1u << 30));
+    crc = ::crc32(crc, data, n);
+    data += n;
+    size -= n;
+  }
+  return static_cast<std::uint32_t>(crc);
+}
 
 std::int64_t step_ns(int k, double rate) {
   return static_cast<std::int64_t>(std::llround(static_cast<double>(k) * 1e9 / rate));
@@ -117,9 +130,17 @@ void DatasetWriter::add_agent(const std::string& name, const std::optional<Camer
 
 namespace {
 
-void write_png(const fs::path& p, const cv::Mat& img) {
+// Encodes and writes a PNG; returns its size and CRC-32 for checksums.csv.
+FrameChecksum write_png(const fs::path& p, const cv::Mat& img) {
+  std::vector<unsigned char> buf;
   // Level 1: several times faster than the default and only slightly larger files.
-  if (!cv::imwrite(p.string(), img, {cv::IMWRITE_PNG_COMPRESSION, 1})) throw std::runtime_error("cannot write " + p.string());
+  if (!cv::imencode(".png", img, buf, {cv::IMWRITE_PNG_COMPRESSION, 1}))
+    throw std::runtime_error("cannot encode " + p.string());
+  std::ofstream f(p, std::ios::binary | std::ios::trunc);
+  f.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
+  f.close();
+  if (!f) throw std::runtime_error("cannot write " + p.string());
+  return {static_cast<std::uint64_t>(buf.size()), crc32_of(buf.data(), buf.size())};
 }
 
 template <typename Row>
@@ -163,9 +184,12 @@ void DatasetWriter::write_frame(const std::string& agent, std::int64_t t_ns, con
   cv::Mat valid = (depth > 0) & (depth < 65.5355);
   depth.convertTo(mm, CV_16U, 1.0 / kDepthScale);
   mm.setTo(0, ~valid);
-  encoder_->push([out, mm, colour_path, depth_path] {
-    write_png(colour_path, out);
-    write_png(depth_path, mm);
+  const std::string colour_rel = agent + "/cam0/data/" + file, depth_rel = agent + "/depth0/data/" + file;
+  encoder_->push([this, out, mm, colour_path, depth_path, colour_rel, depth_rel] {
+    const FrameChecksum c = write_png(colour_path, out), d = write_png(depth_path, mm);
+    std::lock_guard lock(checksums_mutex_);
+    checksums_[colour_rel] = c;
+    checksums_[depth_rel] = d;
   });
   a.frames.push_back(t_ns);
 }
@@ -253,6 +277,10 @@ void DatasetWriter::finish() {
       write_yaml(d / (depth ? "depth0" : "cam0") / "sensor.yaml", e);
     }
   }
+  std::vector<std::pair<std::string, FrameChecksum>> sums(checksums_.begin(), checksums_.end());
+  write_csv(dir_ / kChecksumsFile, "#file,bytes,crc32", sums.size(), [&](std::size_t i) {
+    return fmt::format("{},{},{:08x}", sums[i].first, sums[i].second.bytes, sums[i].second.crc32);
+  });
   for (const auto& a : agents_)
     if (a.camera) info_.frames = static_cast<int>(a.frames.size());
   YAML::Emitter e;

@@ -8,6 +8,7 @@
 #include <fcntl.h>
 
 #include <chrono>
+#include <functional>
 #include <thread>
 
 #include "app/run_config.hpp"
@@ -96,6 +97,57 @@ TEST(RenderCli, BadInputExitsTwoNamingTheFile) {
   r = run_wingman({"render", scn.string(), "--out", (tmp / "precious").string()}, tmp.path());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_TRUE(fs::exists(tmp / "precious" / "thesis.tex"));
+}
+
+// `wingman slam` checks a dataset as a whole before its first step: every failure is bad input
+// (exit 2) naming the file, and nothing is written.
+TEST(RenderCli, SlamRefusesADatasetThatContradictsItsScenarioOrIsDamaged) {
+  TempDir tmp;
+  const fs::path scn = tmp / "tiny.yaml";
+  write_file(scn, tiny_scenario(0.3));
+  const fs::path ds = tmp / "ds";
+  const auto r = run_wingman({"render", scn.string(), "--out", ds.string(), "--gl", "osmesa"}, tmp.path());
+  if (r.exit_code != 0 && r.output.find("OSMesa") != std::string::npos) WINGMAN_NO_GL_CONTEXT(r.output);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path out = tmp / "res";
+  ASSERT_EQ(run_wingman({"slam", ds.string(), "--out", out.string(), "--no-plots", "-q"}, tmp.path()).exit_code, 0);
+  fs::remove_all(out);
+
+  struct Case {
+    std::function<void(const fs::path&)> damage;
+    std::string names;
+  };
+  const std::vector<Case> cases = {
+      {[](const fs::path& d) {  // the scenario says 100 x 100 over 200 x 200 frames
+         std::string t = read_file(d / "scenario.yaml");
+         replace_once(t, "width: 200, height: 200}}\n  - {name: uav2", "width: 100, height: 100}}\n  - {name: uav2");
+         write_file(d / "scenario.yaml", t);
+       },
+       "uav1/cam0/sensor.yaml: the camera (200x200"},
+      {[](const fs::path& d) {
+         std::string t = read_file(d / "dataset.yaml");
+         replace_once(t, "agents: [lead, uav1, uav2]", "agents: [lead, uav1]");
+         write_file(d / "dataset.yaml", t);
+       },
+       "dataset.yaml: agents: no 'uav2'"},
+      {[](const fs::path& d) {
+         const fs::path f = d / "uav2" / "cam0" / "data" / "200000000.png";
+         std::string b = read_file(f);
+         b[b.size() - 100] ^= 0x10;
+         write_file(f, b);
+       },
+       "uav2/cam0/data/200000000.png: CRC-32"},
+  };
+  for (const Case& c : cases) {
+    const fs::path copy = tmp / "copy";
+    fs::remove_all(copy);
+    fs::copy(ds, copy, fs::copy_options::recursive);
+    c.damage(copy);
+    const auto s = run_wingman({"slam", copy.string(), "--out", out.string(), "--no-plots", "-q"}, tmp.path());
+    EXPECT_EQ(s.exit_code, 2) << s.output;
+    EXPECT_NE(s.output.find((copy / c.names).string()), std::string::npos) << s.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 TEST(RenderCli, InterruptLeavesNoDatasetBehind) {

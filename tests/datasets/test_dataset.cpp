@@ -207,3 +207,100 @@ TEST(Dataset, AnImageThatCannotBeWrittenFailsTheWriterNamingIt) {
 
 }  // namespace
 }  // namespace wingman::datasets
+
+namespace wingman::datasets {
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Replaces the first `from` in the file by `to` (which must be there).
+void patch(const fs::path& p, const std::string& from, const std::string& to) {
+  std::string text = slurp(p);
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from << " not in " << p;
+  text.replace(at, from.size(), to);
+  std::ofstream(p, std::ios::binary | std::ios::trunc) << text;
+}
+
+std::string verify_error(const fs::path& dir) {
+  try {
+    verify_frames(read_dataset(dir));
+  } catch (const DatasetError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(Dataset, WriterRecordsEveryFramesSizeAndChecksum) {
+  TempDir tmp;
+  write_small(tmp.path);
+  const std::string sums = slurp(tmp.path / kChecksumsFile);
+  EXPECT_EQ(sums.rfind("#file,bytes,crc32\n", 0), 0u);
+  const std::string frame = slurp(tmp.path / "uav1" / "cam0" / "data" / "100000000.png");
+  const auto crc = crc32_of(reinterpret_cast<const unsigned char*>(frame.data()), frame.size());
+  char line[128];
+  std::snprintf(line, sizeof line, "uav1/cam0/data/100000000.png,%zu,%08x\n", frame.size(), crc);
+  EXPECT_NE(sums.find(line), std::string::npos) << sums;
+  EXPECT_EQ(verify_error(tmp.path), "no error");
+  int calls = 0;
+  verify_frames(read_dataset(tmp.path), [&](int done, int total) {
+    ++calls;
+    EXPECT_EQ(total, 6);
+    EXPECT_EQ(done, calls);
+  });
+  EXPECT_EQ(calls, 6);  // 3 colour and 3 depth frames
+}
+
+TEST(Dataset, AFrameWithAValidHeaderAndABrokenBodyIsFoundBeforeReplay) {
+  TempDir tmp;
+  write_small(tmp.path);
+  const fs::path f = tmp.path / "uav1" / "cam0" / "data" / "0.png";  // frame 0 too
+  std::string bytes = slurp(f);
+  bytes[bytes.size() / 2] ^= 0x5a;
+  std::ofstream(f, std::ios::binary | std::ios::trunc) << bytes;
+  EXPECT_EQ(read_dataset(tmp.path).agents.size(), 2u);  // the header alone looks fine
+  const std::string e = verify_error(tmp.path);
+  EXPECT_NE(e.find(f.string() + ": CRC-32"), std::string::npos) << e;
+  // Without checksums.csv (an older dataset) every frame is decoded instead.
+  fs::remove(tmp.path / kChecksumsFile);
+  std::ofstream(f, std::ios::binary | std::ios::trunc) << bytes.substr(0, 200);
+  EXPECT_NE(verify_error(tmp.path).find(f.string() + ": cannot decode the frame"), std::string::npos);
+}
+
+TEST(Dataset, ValuesOutOfRangeAreRefusedNamingFileAndRow) {
+  struct Case {
+    const char* file;
+    const char* from;
+    const char* to;
+    const char* says;
+  };
+  const std::vector<Case> cases = {
+      {"uav1/cam0/sensor.yaml", "intrinsics: [40", "intrinsics: [0", "fx and fy must be positive"},
+      {"uav1/cam0/sensor.yaml", "intrinsics: [40", "intrinsics: [.nan", "fx and fy must be positive"},
+      {"uav1/cam0/sensor.yaml", "R_CW: [1", "R_CW: [0", "R_CW is not a rotation matrix"},
+      {"uav1/cam0/sensor.yaml", "rate_hz: 10", "rate_hz: -10", "rate_hz must be in (0, 1000]"},
+      {"dataset.yaml", "rate_hz: 10", "rate_hz: -10", "rate_hz must be in (0, 1000]"},
+      {"dataset.yaml", "agents: [lead, uav1]", "agents: [lead, ../uav1]", "is not an agent name"},
+      {"dataset.yaml", "agents: [lead, uav1]", "agents: [lead, uav1, uav1]", "listed twice"},
+      {"lead/gps0/data.csv", "100000000,1.5", "100000000,nan", "data row 2: nan is not a finite value"},
+      {"lead/gps0/data.csv", "100000000,1.5", "100000000,1e308", "data row 2: 1e308 is not a finite value"},
+      {"uav1/altimeter0/data.csv", "200000000,", "000000001,", "data row 3: time stamps must increase"},
+      {"lead/groundtruth/data.csv", "0.9238795", "0.5", "the quaternion has norm"},
+  };
+  for (const Case& c : cases) {
+    TempDir tmp;
+    write_small(tmp.path);
+    patch(tmp.path / c.file, c.from, c.to);
+    const std::string e = error_of(tmp.path);
+    EXPECT_NE(e.find((tmp.path / c.file).string()), std::string::npos) << c.to << ": " << e;
+    EXPECT_NE(e.find(c.says), std::string::npos) << c.to << ": " << e;
+  }
+}
+
+}  // namespace
+}  // namespace wingman::datasets

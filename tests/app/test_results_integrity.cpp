@@ -1,0 +1,179 @@
+// Nothing lost, nothing silent: interrupted and killed runs, existing results, numerical
+// failures of the filter and Monte Carlo directories resumed with other settings, each through
+// the real `wingman` binary.
+// GCC 12 warns falsely about std::string concatenation inlined from gtest (GCC bug 105329).
+#pragma GCC diagnostic ignored "-Wrestrict"
+#include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <thread>
+
+#include "app_test_support.hpp"
+
+namespace wingman::app::test {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::IsEmpty;
+
+// smoke.yaml flown for `seconds`: long enough to interrupt while it computes.
+fs::path long_smoke(const TempDir& tmp, double seconds) {
+  std::string text = read_file(kSmoke);
+  replace_top_level_value(text, "duration", std::to_string(seconds));
+  replace_once(text, "to: 24, config: 3}", "to: " + std::to_string(seconds) + ", config: 3}");
+  const fs::path p = tmp / "long.yaml";
+  write_file(p, text);
+  return p;
+}
+
+// Entries of dir whose names start with `prefix` and hold ".partial-" or ".old-".
+std::vector<std::string> leftovers(const fs::path& dir, const std::string& prefix) {
+  std::vector<std::string> v;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind(prefix, 0) == 0 && (n.find(".partial-") != std::string::npos || n.find(".old-") != std::string::npos))
+      v.push_back(n);
+  }
+  return v;
+}
+
+// Starts `wingman args...` with its output to `log`, waits until its staging directory for
+// `out` exists plus `after`, and sends `sig`. Returns the wait status.
+int signal_while_running(const std::vector<std::string>& args, const fs::path& out, const fs::path& log,
+                         int sig, std::chrono::milliseconds after = std::chrono::milliseconds(300)) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    std::vector<char*> argv{const_cast<char*>("wingman")};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(kBinary.c_str(), argv.data());
+    _exit(127);
+  }
+  const std::string staging = out.filename().string() + ".partial-" + std::to_string(pid);
+  for (int i = 0; i < 600 && !fs::exists(out.parent_path() / staging); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_TRUE(fs::exists(out.parent_path() / staging)) << "the run never started writing";
+  std::this_thread::sleep_for(after);
+  kill(pid, sig);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return status;
+}
+
+TEST(ResultsIntegrity, RunStopsOnSigintAndSigtermWithNothingWritten) {
+  TempDir tmp;
+  const fs::path scn = long_smoke(tmp, 2000);
+  const fs::path out = tmp / "res";
+  for (const auto& [sig, code] : {std::pair{SIGINT, 130}, std::pair{SIGTERM, 143}}) {
+    const int st = signal_while_running({"run", scn.string(), "--out", out.string(), "--no-plots", "-q"}, out,
+                                        tmp / "log.txt", sig);
+    ASSERT_TRUE(WIFEXITED(st)) << "killed by the signal instead of stopping";
+    EXPECT_EQ(WEXITSTATUS(st), code);
+    EXPECT_THAT(read_file(tmp / "log.txt"), HasSubstr("interrupted by SIG"));
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_THAT(leftovers(tmp.path(), "res"), IsEmpty());
+  }
+}
+
+TEST(ResultsIntegrity, KilledRunLosesNoResultAndItsStagingIsRemovedByTheNext) {
+  TempDir tmp;
+  const fs::path out = tmp / "res";
+  ASSERT_EQ(run_wingman({"run", kSmoke.string(), "--out", out.string(), "--no-plots", "-q"}, tmp.path()).exit_code, 0);
+  const std::string before = read_file(out / "multi" / "metrics.json");
+  // SIGKILL cannot be handled: the staging directory stays, the previous result is untouched.
+  const fs::path scn = long_smoke(tmp, 2000);
+  const int st = signal_while_running({"run", scn.string(), "--out", out.string(), "--no-plots", "-q", "--force"},
+                                      out, tmp / "log.txt", SIGKILL);
+  ASSERT_TRUE(WIFSIGNALED(st));
+  EXPECT_EQ(read_file(out / "multi" / "metrics.json"), before);
+  ASSERT_EQ(leftovers(tmp.path(), "res").size(), 1u);
+  // The next run into the same place finds it, names it and removes it.
+  const RunResult r = run_wingman({"run", kSmoke.string(), "--out", out.string(), "--no-plots", "-q", "--force"},
+                                  tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("note: removed " + (tmp / "res.partial-").string()));
+  EXPECT_THAT(r.output, HasSubstr("which is gone"));
+  EXPECT_THAT(leftovers(tmp.path(), "res"), IsEmpty());
+}
+
+TEST(ResultsIntegrity, AddingAVariantToExistingResultsIsRefused) {
+  TempDir tmp;
+  const fs::path out = tmp / "res";
+  ASSERT_EQ(run_wingman({"run", kSmoke.string(), "--out", out.string(), "--no-plots", "-q"}, tmp.path()).exit_code, 0);
+  const RunResult r = run_wingman(
+      {"run", kSmoke.string(), "--out", out.string(), "--no-plots", "-q", "--variant", "single"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(out.string() + "' already holds wingman results"));
+  EXPECT_TRUE(fs::exists(out / "multi" / "metrics.json"));  // never partly deleted
+  EXPECT_TRUE(fs::exists(out / "single" / "metrics.json"));
+}
+
+TEST(ResultsIntegrity, NumericalFailureOfTheFilterIsAnErrorAtItsStep) {
+  TempDir tmp;
+  std::string text = read_file(kSmoke);
+  // A filter GPS sigma of 1e-9 m: the covariance loses positive definiteness in its update.
+  const int line = replace_once(text, "gps_sigma: 1.5, altimeter", "gps_sigma: 1e-9, altimeter");
+  ASSERT_GT(line, 0);
+  write_file(tmp / "gps.yaml", text);
+  const fs::path out = tmp / "res";
+  const RunResult r = run_wingman({"run", (tmp / "gps.yaml").string(), "--out", out.string(), "--no-plots", "-q"},
+                                  tmp.path());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("gps.yaml: step "));
+  EXPECT_THAT(r.output, HasSubstr("numerical failure in the filter after the sensor update (the GPS fix"));
+  EXPECT_THAT(r.output, HasSubstr("camera 0 is uav1"));
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_THAT(leftovers(tmp.path(), "res"), IsEmpty());
+
+  // Truth noise no filter can follow: the first non-finite value is named, never written.
+  text = read_file(kSmoke);
+  replace_once(text, "  pixel_sigma: 3\n", "  pixel_sigma: 1e300\n");
+  write_file(tmp / "px.yaml", text);
+  const RunResult p = run_wingman({"run", (tmp / "px.yaml").string(), "--out", out.string(), "--no-plots", "-q"},
+                                  tmp.path());
+  EXPECT_EQ(p.exit_code, 1) << p.output;
+  EXPECT_THAT(p.output, HasSubstr("px.yaml: step 1 (t = 0.1 s; camera 0 is uav1): numerical failure"));
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(ResultsIntegrity, MonteCarloRefusesToResumeWithOtherSettings) {
+  TempDir tmp;
+  const fs::path out = tmp / "mc";
+  RunResult r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "1", "--out", out.string(), "--no-plots",
+                             "-q", "--variant", "multi"},
+                            tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string before = read_file(out / "montecarlo.json");
+  std::string text = read_file(kSmoke);
+  replace_once(text, "pixel_sigma: 3, gps", "pixel_sigma: 2, gps");
+  write_file(tmp / "other.yaml", text);
+  r = run_wingman({"montecarlo", (tmp / "other.yaml").string(), "--runs", "2", "--out", out.string(), "--no-plots",
+                   "-q", "--variant", "multi", "--resume"},
+                  tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("its runs were made with other settings"));
+  EXPECT_THAT(r.output, HasSubstr("key estimator.measurement_noise.pixel_sigma"));
+  EXPECT_FALSE(fs::exists(out / "runs" / "seed2"));
+  EXPECT_EQ(read_file(out / "montecarlo.json"), before);
+  // Other options count too: a --duration limit changes every run.
+  r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "2", "--out", out.string(), "--no-plots", "-q",
+                   "--variant", "multi", "--resume", "--duration", "10"},
+                  tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("duration_limit"));
+  // The same settings resume.
+  r = run_wingman({"montecarlo", kSmoke.string(), "--runs", "2", "--out", out.string(), "--no-plots", "-q",
+                   "--variant", "multi", "--resume"},
+                  tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(out / "runs" / "seed2" / "multi" / "metrics.json"));
+}
+
+}  // namespace
+}  // namespace wingman::app::test
