@@ -3,8 +3,9 @@
 // average NEES with its chi^2 bounds per step, the fraction of steps inside them per phase, and
 // the spread of Table 4 (eval/montecarlo), and every later variant compared with the first seed by
 // seed (eval/paired: the paper scenes' single-UAV against multi-UAV). Workers are processes, not
-// threads, so a crash or an abort in one run costs that run only. Ctrl-C stops the workers and
-// keeps the finished runs; --resume skips them.
+// threads, so a crash or an abort in one run costs that run only. Ctrl-C or SIGTERM stops the
+// workers and keeps the finished runs (exit 130/143); --resume skips them. A worker stops when
+// its parent dies, even by SIGKILL (app/interrupt.hpp).
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include <fcntl.h>
@@ -13,10 +14,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cerrno>
 #include <chrono>
-#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -25,6 +24,7 @@
 #include <optional>
 #include <thread>
 
+#include "app/interrupt.hpp"
 #include "app/montecarlo_study.hpp"
 #include "app/progress.hpp"
 #include "app/subcommand.hpp"
@@ -60,8 +60,6 @@ struct MonteCarloOptions {
   bool quiet = false;
 };
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void montecarlo_on_interrupt(int) { g_interrupted = true; }
 
 fs::path run_dir(const fs::path& out, std::uint64_t seed) {
   return out / "runs" / fmt::format("seed{}", seed);
@@ -98,7 +96,14 @@ pid_t spawn_worker(const MonteCarloOptions& o, std::uint64_t seed, const fs::pat
   posix_spawnattr_setpgroup(&attr, 0);
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
   pid_t pid = -1;
-  const int rc = posix_spawn(&pid, "/proc/self/exe", &fa, &attr, argv.data(), environ);
+  // The worker learns its parent (app/interrupt.hpp: it stops when the parent dies, even by SIGKILL).
+  std::vector<std::string> env_text = {std::string(kWorkerOfEnv) + "=" + std::to_string(::getpid())};
+  for (char** e = environ; *e; ++e)
+    if (std::string(*e).rfind(std::string(kWorkerOfEnv) + "=", 0) != 0) env_text.emplace_back(*e);
+  std::vector<char*> envp;
+  for (auto& e : env_text) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const int rc = posix_spawn(&pid, "/proc/self/exe", &fa, &attr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&fa);
   posix_spawnattr_destroy(&attr);
   if (rc != 0) throw std::runtime_error(fmt::format("cannot start a worker: {}", std::strerror(rc)));
@@ -113,77 +118,24 @@ std::vector<std::pair<std::string, std::string>> variant_labels(const std::vecto
   return v;
 }
 
-int montecarlo_command(const MonteCarloOptions& o) {
-  if (o.runs < 1) throw UsageError("--runs must be at least 1");
-  if (o.batch != 0 && (o.batch < 2 || o.batch > o.runs))
-    throw UsageError(fmt::format("--batch {}: a batch needs 2 to --runs ({}) runs", o.batch, o.runs));
-  // Bad input fails here, before any work.
-  const auto scenarios = select_variants(load_run_configs(o.scenario), o.variants, o.scenario);
-  o.limit.seconds(scenarios.front().rate);  // a bad --duration or --frames fails here, not per worker
-  if (!o.no_plots && !eval::gnuplot_available())
-    throw UsageError("gnuplot with the pngcairo terminal was not found; install it (setup.sh does) "
-                     "or pass --no-plots");
-  const fs::path out =
-      o.out.empty() ? fs::path("results") / (scenarios.front().name + "_montecarlo") : fs::path(o.out);
-  const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
-
-  // The output directory: new, or one of ours (refused without --resume if it holds runs, and
-  // with other settings than its runs were made with).
-  std::error_code ec;
-  if (fs::exists(out)) {
-    if (!fs::is_directory(out) || (!fs::exists(out / kMarker) && !fs::is_empty(out, ec)))
-      throw UsageError(fmt::format("{}: exists and is not a wingman Monte Carlo directory; choose "
-                                   "another --out", out.string()));
-  }
-  std::vector<std::uint64_t> pending, finished;
-  for (int i = 0; i < o.runs; ++i) {
-    const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
-    if (eval::ResultsDir::is_results_dir(run_dir(out, seed))) {
-      if (!o.resume)
-        throw UsageError(fmt::format("{}: already holds finished runs (seed {}); pass --resume to "
-                                     "keep them and run the rest, or choose another --out",
-                                     out.string(), seed));
-      finished.push_back(seed);
-    } else {
-      pending.push_back(seed);
-    }
-  }
-  const std::string settings = study_settings(scenarios, o.limit);
-  if (fs::exists(out / kStudySettingsFile)) record_or_check_study(out, settings);
-  fs::create_directories(out / "runs");
-  eval::write_file_atomic(out / kMarker, o.scenario + "\n");
-  record_or_check_study(out, settings);
-  // Staging directories of workers that were stopped: never complete, always safe to drop.
-  for (const auto& e : fs::directory_iterator(out / "runs"))
-    if (e.is_directory() && e.path().filename().string().find(".partial-") != std::string::npos)
-      fs::remove_all(e.path(), ec);
-
-  if (!o.quiet && !finished.empty())
-    fmt::print(stderr, "resuming: {} of {} runs already finished\n", finished.size(), o.runs);
-
-  struct sigaction sa {};
-  sa.sa_handler = montecarlo_on_interrupt;
-  sigemptyset(&sa.sa_mask);
-  struct sigaction old_int {}, old_term {};
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
-
+// Runs the pending seeds in `jobs` worker processes, adding each to `finished` or `failed` as it
+// ends. On SIGINT/SIGTERM (app/interrupt.hpp) stops the running workers, which remove their own
+// staging directories, and returns false.
+bool run_workers(const MonteCarloOptions& o, const fs::path& out, const std::vector<std::uint64_t>& pending,
+                 int jobs, std::vector<std::uint64_t>& finished,
+                 std::vector<std::pair<std::uint64_t, std::string>>& failed) {
   std::map<pid_t, std::uint64_t> running;
-  std::vector<std::pair<std::uint64_t, std::string>> failed;
-  const std::size_t to_run = pending.size();
   std::size_t next = 0, done_now = 0;
   ProgressLine progress("[montecarlo]", o.quiet);
-  auto status = [&] {
-    return fmt::format("runs ({} running, {} failed)", running.size(), failed.size());
-  };
-  while (!g_interrupted && (next < pending.size() || !running.empty())) {
-    while (!g_interrupted && next < pending.size() && static_cast<int>(running.size()) < jobs) {
+  auto status = [&] { return fmt::format("runs ({} running, {} failed)", running.size(), failed.size()); };
+  while (!interrupt_signal() && (next < pending.size() || !running.empty())) {
+    while (!interrupt_signal() && next < pending.size() && static_cast<int>(running.size()) < jobs) {
       const std::uint64_t seed = pending[next++];
       running[spawn_worker(o, seed, out)] = seed;
     }
-    progress.update(static_cast<int>(done_now), static_cast<int>(to_run), status());
+    progress.update(static_cast<int>(done_now), static_cast<int>(pending.size()), status());
     int st = 0;
-    const pid_t pid = ::waitpid(-1, &st, 0);
+    const pid_t pid = ::waitpid(-1, &st, 0);  // EINTR when a signal arrives
     if (pid < 0) {
       if (errno == EINTR) continue;
       break;
@@ -203,22 +155,74 @@ int montecarlo_command(const MonteCarloOptions& o) {
       fmt::print(stderr, "\nrun seed {} failed ({}); log: {}\n", seed, why, log.string());
     }
   }
-  progress.update(static_cast<int>(done_now), static_cast<int>(to_run), status());
+  progress.update(static_cast<int>(done_now), static_cast<int>(pending.size()), status());
   progress.finish();
-  if (g_interrupted) {
-    for (const auto& [pid, seed] : running) ::kill(pid, SIGTERM);
-    for (const auto& [pid, seed] : running) ::waitpid(pid, nullptr, 0);
-    for (const auto& e : fs::directory_iterator(out / "runs"))
-      if (e.is_directory() && e.path().filename().string().find(".partial-") != std::string::npos)
-        fs::remove_all(e.path(), ec);
-    sigaction(SIGINT, &old_int, nullptr);
-    sigaction(SIGTERM, &old_term, nullptr);
+  if (!interrupt_signal()) return true;
+  for (const auto& [pid, seed] : running) ::kill(pid, SIGTERM);
+  for (const auto& [pid, seed] : running) ::waitpid(pid, nullptr, 0);
+  eval::ResultsDir::remove_stale_staging(out / "runs");
+  return false;
+}
+
+// The output directory: new, or one of ours (refused without --resume if it holds runs, and
+// with other settings than its runs were made with). Splits the seeds into pending and finished.
+void open_study(const MonteCarloOptions& o, const fs::path& out, const std::vector<RunConfig>& scenarios,
+                std::vector<std::uint64_t>& pending, std::vector<std::uint64_t>& finished) {
+  std::error_code ec;
+  if (fs::exists(out)) {
+    if (!fs::is_directory(out) || (!fs::exists(out / kMarker) && !fs::is_empty(out, ec)))
+      throw UsageError(fmt::format("{}: exists and is not a wingman Monte Carlo directory; choose "
+                                   "another --out", out.string()));
+  }
+  for (int i = 0; i < o.runs; ++i) {
+    const std::uint64_t seed = o.first_seed + static_cast<std::uint64_t>(i);
+    if (eval::ResultsDir::is_results_dir(run_dir(out, seed))) {
+      if (!o.resume)
+        throw UsageError(fmt::format("{}: already holds finished runs (seed {}); pass --resume to "
+                                     "keep them and run the rest, or choose another --out",
+                                     out.string(), seed));
+      finished.push_back(seed);
+    } else {
+      pending.push_back(seed);
+    }
+  }
+  const std::string settings = study_settings(scenarios, o.limit);
+  if (fs::exists(out / kStudySettingsFile)) record_or_check_study(out, settings);
+  fs::create_directories(out / "runs");
+  eval::write_file_atomic(out / kMarker, o.scenario + "\n");
+  record_or_check_study(out, settings);
+  // Staging directories of workers that were stopped: never complete; dropped once their process is gone.
+  for (const auto& note : eval::ResultsDir::remove_stale_staging(out / "runs"))
+    if (!o.quiet) fmt::print(stderr, "note: {}\n", note);
+
+}
+
+int montecarlo_command(const MonteCarloOptions& o) {
+  if (o.runs < 1) throw UsageError("--runs must be at least 1");
+  if (o.batch != 0 && (o.batch < 2 || o.batch > o.runs))
+    throw UsageError(fmt::format("--batch {}: a batch needs 2 to --runs ({}) runs", o.batch, o.runs));
+  // Bad input fails here, before any work.
+  const auto scenarios = select_variants(load_run_configs(o.scenario), o.variants, o.scenario);
+  o.limit.seconds(scenarios.front().rate);  // a bad --duration or --frames fails here, not per worker
+  if (!o.no_plots && !eval::gnuplot_available())
+    throw UsageError("gnuplot with the pngcairo terminal was not found; install it (setup.sh does) "
+                     "or pass --no-plots");
+  const fs::path out =
+      o.out.empty() ? fs::path("results") / (scenarios.front().name + "_montecarlo") : fs::path(o.out);
+  const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+
+  std::vector<std::uint64_t> pending, finished;
+  open_study(o, out, scenarios, pending, finished);
+  if (!o.quiet && !finished.empty())
+    fmt::print(stderr, "resuming: {} of {} runs already finished\n", finished.size(), o.runs);
+
+  std::vector<std::pair<std::uint64_t, std::string>> failed;
+  if (!run_workers(o, out, pending, jobs, finished, failed)) {
+    const int sig = interrupt_signal();
     fmt::print(stderr, "interrupted: {} of {} runs finished and kept in {}; rerun with --resume to "
                "run the rest\n", finished.size(), o.runs, out.string());
-    return 130;
+    return 128 + sig;
   }
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
 
   std::sort(finished.begin(), finished.end());
   if (finished.empty()) {

@@ -47,6 +47,7 @@ int run_cli(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
   InterruptGuard interrupts;
+  stop_with_parent();
   try {
     for (const auto& c : commands)
       if (c.cli->parsed()) return c.run();

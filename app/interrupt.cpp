@@ -1,8 +1,11 @@
 #include "app/interrupt.hpp"
 
 #include <signal.h>
+#include <sys/prctl.h>
+#include <unistd.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <string>
 
 namespace wingman::app {
@@ -34,6 +37,13 @@ InterruptGuard::InterruptGuard() {
 InterruptGuard::~InterruptGuard() {
   sigaction(SIGINT, &g_old_int, nullptr);
   sigaction(SIGTERM, &g_old_term, nullptr);
+}
+
+void stop_with_parent() {
+  const char* parent = std::getenv(kWorkerOfEnv);
+  if (!parent) return;
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (std::to_string(::getppid()) != parent) g_signal = SIGTERM;  // died before prctl took hold
 }
 
 int interrupt_signal() { return g_signal; }

@@ -23,6 +23,13 @@ class InterruptGuard {
   InterruptGuard& operator=(const InterruptGuard&) = delete;
 };
 
+// A Monte Carlo worker's environment names its parent's pid here; the worker asks the kernel for
+// SIGTERM when that parent dies, so a killed `wingman montecarlo` leaves no orphan runs behind.
+inline constexpr const char* kWorkerOfEnv = "WINGMAN_WORKER_OF";
+// Called once at start: with kWorkerOfEnv set, SIGTERM on the parent's death (and at once if the
+// parent is already gone).
+void stop_with_parent();
+
 // The signal received since the guard was installed, or 0.
 int interrupt_signal();
 void throw_if_interrupted();

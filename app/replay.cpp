@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "app/interrupt.hpp"
 #include "app/progress.hpp"
 #include "app/subcommand.hpp"
 #include "app/variants.hpp"
@@ -98,7 +99,10 @@ Replay load_replay(const std::string& dir, const std::string& variant, bool quie
   // error an hour into the replay.
   ProgressLine progress(fmt::format("[verify {}]", dir), quiet);
   try {
-    datasets::verify_frames(r.dataset, [&](int k, int n) { progress.update(k, n, "frames"); });
+    datasets::verify_frames(r.dataset, [&](int k, int n) {
+      throw_if_interrupted();
+      progress.update(k, n, "frames");
+    });
   } catch (const datasets::DatasetError& e) {
     throw UsageError(e.what());
   }

@@ -94,6 +94,27 @@ void check_replaceable(const fs::path& final_dir, const ResultsDir::Options& o) 
 
 }  // namespace
 
+std::vector<std::string> ResultsDir::remove_stale_staging(const fs::path& dir) {
+  std::vector<std::string> notes;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    const auto at = name.rfind(kPartial);
+    if (at == std::string::npos || at == 0) continue;
+    const long pid = sibling_pid(name, name.substr(0, at) + kPartial);
+    if (pid < 0) continue;
+    if (process_alive(pid)) {
+      notes.push_back(e.path().string() + " is being written by process " + std::to_string(pid) +
+                      ", which is still running; left alone");
+    } else {
+      fs::remove_all(e.path(), ec);
+      notes.push_back("removed " + e.path().string() + ", left by process " + std::to_string(pid) +
+                      ", which is gone");
+    }
+  }
+  return notes;
+}
+
 bool ResultsDir::is_results_dir(const fs::path& dir) {
   std::error_code ec;
   return fs::is_directory(dir, ec) && fs::is_regular_file(dir / kMarker, ec);

@@ -42,6 +42,11 @@ class ResultsDir {
   // until destruction) if final_dir appeared meanwhile and may not be replaced, or a rename fails.
   void commit();
 
+  // Removes every "<name>.partial-<pid>" directly in `dir` whose process is gone (a staging
+  // directory is never complete); returns one note per directory removed or left to its
+  // running process.
+  static std::vector<std::string> remove_stale_staging(const std::filesystem::path& dir);
+
   // True if dir is a directory holding the marker file.
   static bool is_results_dir(const std::filesystem::path& dir);
   // The kind a marked directory holds ("results", "dataset"); "" when it is not ours.

@@ -12,13 +12,15 @@
 namespace wingman::sim {
 namespace {
 
-// Bytes per unit, measured as orders of magnitude (docs/reliability.md): a step's records with
-// one agent's share, a synthetic landmark, a terrain vertex (CPU mesh and its GL copy), a pixel
-// of a rendered frame (colour, depth, gray, GL buffers, the prefetched next frame).
-constexpr double kStepBytes = 600, kAgentStepBytes = 500, kLandmarkBytes = 96, kVertexBytes = 96,
+// Bytes per unit (docs/reliability.md has the measurements): a step's records with one agent's
+// share (smoke.yaml over 3e5 steps peaks at 0.91 GB), a synthetic landmark, a terrain vertex (CPU
+// mesh and its GL copy), a pixel of a rendered frame (colour, depth, gray, GL buffers, the
+// prefetched next frame).
+constexpr double kStepBytes = 1000, kAgentStepBytes = 700, kLandmarkBytes = 96, kVertexBytes = 96,
                  kPixelBytes = 48;
-// Wall time: a synthetic step, and a rendered camera frame (render + detect + match), 2 cores.
-constexpr double kSyntheticStepSeconds = 2e-3, kRenderedFrameSeconds = 0.08;
+// Wall time on 2 cores: a synthetic step of the paper scene (5 ms) and a rendered camera frame
+// (render + detect + match, about twice the paper scene's 40 ms), both on the safe side.
+constexpr double kSyntheticStepSeconds = 5e-3, kRenderedFrameSeconds = 0.08;
 
 // The flight's horizontal bounding box, sampled at most 10 000 times (the analytic trajectory
 // plus each agent's offset from the lead), so estimating never costs what it guards against.

@@ -175,5 +175,30 @@ TEST(ResultsIntegrity, MonteCarloRefusesToResumeWithOtherSettings) {
   EXPECT_TRUE(fs::exists(out / "runs" / "seed2" / "multi" / "metrics.json"));
 }
 
+// A SIGKILL of `wingman montecarlo` cannot be handled, but its workers notice (the kernel sends
+// them SIGTERM when their parent dies): they stop and remove their staging directories.
+TEST(ResultsIntegrity, KilledMonteCarloTakesItsWorkersWithIt) {
+  TempDir tmp;
+  const fs::path scn = long_smoke(tmp, 2000);
+  const fs::path out = tmp / "mc";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = ::open((tmp / "log.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    execl(kBinary.c_str(), "wingman", "montecarlo", scn.c_str(), "--runs", "2", "--jobs", "2", "--out",
+          out.c_str(), "--no-plots", "--variant", "multi", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  auto staging = [&] { return fs::exists(out / "runs") ? leftovers(out / "runs", "seed") : std::vector<std::string>{}; };
+  for (int i = 0; i < 600 && staging().size() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_EQ(staging().size(), 2u) << "the workers never started";
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  for (int i = 0; i < 200 && !staging().empty(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_THAT(staging(), IsEmpty()) << "orphaned workers kept running";
+  EXPECT_FALSE(fs::exists(out / "montecarlo.json"));
+}
+
 }  // namespace
 }  // namespace wingman::app::test
