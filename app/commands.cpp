@@ -13,6 +13,7 @@
 #include "app/version.hpp"
 #include "datasets/dataset.hpp"
 #include "sim/scenario.hpp"
+#include "sim/yaml_input.hpp"
 
 namespace wingman::app {
 
@@ -55,16 +56,16 @@ int run_cli(int argc, char** argv) {
     fmt::print(stderr, "\n{}\n", e.what());
     return e.exit_code();
   } catch (const sim::ScenarioError& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
+    fmt::print(stderr, "error: {}\n", sim::printable(e.what()));
     return 2;
   } catch (const UsageError& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
+    fmt::print(stderr, "error: {}\n", sim::printable(e.what()));
     return 2;
   } catch (const datasets::DatasetError& e) {  // a frame or file of a dataset that is bad input
-    fmt::print(stderr, "error: {}\n", e.what());
+    fmt::print(stderr, "error: {}\n", sim::printable(e.what()));
     return 2;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
+    fmt::print(stderr, "error: {}\n", sim::printable(e.what()));
     return 1;
   }
   return 0;

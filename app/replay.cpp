@@ -9,6 +9,7 @@
 #include "app/progress.hpp"
 #include "app/subcommand.hpp"
 #include "app/variants.hpp"
+#include "sim/yaml_input.hpp"
 
 namespace wingman::app {
 namespace {
@@ -55,16 +56,31 @@ void check_against_scenario(const datasets::Dataset& ds, const RunConfig& scn, c
       if (a.name == name) return &a;
     return nullptr;
   };
-  if (!find("lead")) throw UsageError(fmt::format("{}: agents: no 'lead' (its ground truth is needed)", yf));
+  if (ds.info.scenario != scn.name)
+    throw UsageError(fmt::format("{}: scenario '{}', but {} is '{}'", yf, sim::printable(ds.info.scenario),
+                                 scn_path.string(), scn.name));
+  const datasets::AgentData* lead = find("lead");
+  if (!lead) throw UsageError(fmt::format("{}: agents: no 'lead' (its ground truth is needed)", yf));
+  const datasets::AgentData* first = find(scn.uavs.front().name);
+  const std::size_t frames = first ? first->frames.size() : 0;
+  // Every sensor the scenario carries has a sample for every frame.
+  auto samples = [&](const datasets::AgentData& a, const char* folder, std::size_t n) {
+    if (n < frames)
+      throw UsageError(fmt::format("{}: {} samples for {} frames (the scenario's {} carries it)",
+                                   (ds.root / a.name / folder / "data.csv").string(), n, frames, a.name));
+  };
+  if (scn.lead.gps) samples(*lead, "gps0", lead->gps.size());
   for (const auto& u : scn.uavs) {
     const datasets::AgentData* a = find(u.name);
     if (!a)
       throw UsageError(fmt::format("{}: agents: no '{}', a UAV of {} ({})", yf, u.name, scn_path.string(),
                                    scn.uav_names()));
     check_camera(*a, u, scn.rate, ds.root, scn_path);
-    if (a->frames.size() != ds.agents.front().frames.size() && a->camera && ds.agents.front().camera)
+    if (a->frames.size() != frames)
       throw UsageError(fmt::format("{}: {} has {} frames, {} has {}", yf, a->name, a->frames.size(),
-                                   ds.agents.front().name, ds.agents.front().frames.size()));
+                                   scn.uavs.front().name, frames));
+    if (u.altimeter) samples(*a, "altimeter0", a->altimeter.size());
+    if (u.range) samples(*a, "range0", a->range.size());
     if (a->groundtruth.size() < a->frames.size())
       throw UsageError(fmt::format("{}: {} poses for {} frames",
                                    (ds.root / a->name / "groundtruth" / "data.csv").string(), a->groundtruth.size(),

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "eval/atomic_file.hpp"
 #include "sim/settings_yaml.hpp"
 #include "sim/yaml_input.hpp"
 
@@ -251,9 +252,7 @@ std::string config_yaml(const RunConfig& cfg) {
 }
 
 void write_config(const RunConfig& cfg, const std::filesystem::path& path) {
-  std::ofstream f(path);
-  f << config_yaml(cfg);
-  if (!f) throw std::runtime_error(path.string() + ": cannot write the resolved configuration");
+  eval::write_file_atomic(path, config_yaml(cfg));
 }
 
 void limit_duration(RunConfig& cfg, double duration) {

@@ -46,16 +46,18 @@ struct SlidingModeSettings {
   // The controller's keys of the scenario's control: section (sim owns the others).
   template <class V>
   void visit(V& v) {
-    v("k1", k1, geometry::ge(0));
-    v("k2", k2, geometry::gt(0));
+    // Gains and limits of a multirotor's velocity loop: the bounds keep a typo from flying the
+    // formation out of the world (and the filter with it).
+    v("k1", k1, geometry::in(0, 1e3));
+    v("k2", k2, geometry::in(0, 1e3, true));
     v.choice("switching", switching,
              {{"sign", Switching::Sign}, {"sat", Switching::Saturation}, {"tanh", Switching::Tanh}});
     v("boundary_width", boundary_width, geometry::gt(0));
     v.section("limits", [&](auto& l) {
-      l("horizontal_speed", max_horizontal_speed, geometry::gt(0));
-      l("vertical_speed", max_vertical_speed, geometry::gt(0));
-      l("yaw_rate", max_yaw_rate, geometry::gt(0));
-      l("acceleration", max_acceleration, geometry::ge(0));
+      l("horizontal_speed", max_horizontal_speed, geometry::in(0, 100, true));
+      l("vertical_speed", max_vertical_speed, geometry::in(0, 100, true));
+      l("yaw_rate", max_yaw_rate, geometry::in(0, 10, true));
+      l("acceleration", max_acceleration, geometry::in(0, 100));
     });
     v("anti_windup", anti_windup);
     v("lead_bearing_min_range", lead_bearing_min_range, geometry::ge(0));

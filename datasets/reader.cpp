@@ -310,6 +310,13 @@ Dataset read_dataset(const fs::path& dir) {
     a.groundtruth = read_poses(ad / "groundtruth" / "data.csv", true);
     if (fs::exists(ad / "cam0", ec)) {
       a.camera = read_camera(ad / "cam0" / "sensor.yaml", ds.info.rate);
+      // The depth frames are the colour frames' pixels: the same camera.
+      const CameraInfo depth_cam = read_camera(ad / "depth0" / "sensor.yaml", ds.info.rate);
+      if (depth_cam.camera.width() != a.camera->camera.width() ||
+          depth_cam.camera.height() != a.camera->camera.height() ||
+          depth_cam.camera.fx() != a.camera->camera.fx() || depth_cam.camera.fy() != a.camera->camera.fy() ||
+          depth_cam.camera.cx() != a.camera->camera.cx() || depth_cam.camera.cy() != a.camera->camera.cy())
+        fail(ad / "depth0" / "sensor.yaml", "its resolution or intrinsics differ from cam0/sensor.yaml");
       a.frames = read_frames(ad / "cam0", *a.camera, false);
       const auto depth = read_frames(ad / "depth0", *a.camera, true);
       if (depth != a.frames)

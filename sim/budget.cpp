@@ -24,8 +24,9 @@ constexpr double kSyntheticStepSeconds = 5e-3, kRenderedFrameSeconds = 0.08;
 
 // The flight's horizontal bounding box, sampled at most 10 000 times (the analytic trajectory
 // plus each agent's offset from the lead), so estimating never costs what it guards against.
-Eigen::Vector4d sampled_extent(const Scenario& s) {
+Eigen::Vector4d sampled_extent(const Scenario& s, double& max_abs_z) {
   Eigen::Vector4d box(INFINITY, INFINITY, -INFINITY, -INFINITY);
+  max_abs_z = 0;
   const int n = 10000;
   const Eigen::Vector3d origin = nominal_motion(s.lead.trajectory, 0).position;
   for (int k = 0; k <= n; ++k) {
@@ -35,6 +36,7 @@ Eigen::Vector4d sampled_extent(const Scenario& s) {
       box(1) = std::min(box(1), p.y() + start.y());
       box(2) = std::max(box(2), p.x() + start.x());
       box(3) = std::max(box(3), p.y() + start.y());
+      max_abs_z = std::max(max_abs_z, std::abs(p.z() + start.z()));
     };
     grow(s.lead.initial_position);
     for (const auto& u : s.uavs) grow(u.initial_position);
@@ -48,7 +50,7 @@ RunEstimate estimate_run(const Scenario& s) {
   RunEstimate e;
   e.steps = s.duration * s.rate;
   const double agents = 1.0 + static_cast<double>(s.uavs.size());
-  const Eigen::Vector4d box = sampled_extent(s);
+  const Eigen::Vector4d box = sampled_extent(s, e.max_abs_z_m);
   const double wx = box(2) - box(0), wy = box(3) - box(1);
   e.extent_m = std::max(wx, wy);
   const double m = s.field.margin;

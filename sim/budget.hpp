@@ -16,6 +16,7 @@ namespace wingman::sim {
 struct RunEstimate {
   double steps = 0;             // after t = 0
   double extent_m = 0;          // side of the flight's horizontal bounding box
+  double max_abs_z_m = 0;       // the flight's largest height (or depth) from z = 0
   double landmarks = 0;         // synthetic field points
   double terrain_vertices = 0;  // rendered: terrain mesh vertices
   double pixels = 0;            // rendered: pixels of one step's frames, every camera

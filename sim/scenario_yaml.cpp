@@ -52,14 +52,9 @@ bool scenario_name_ok(const std::string& s) {
   });
 }
 
-// A name as a message may print it: bytes outside printable ASCII as \xNN, at most 80 of them.
-std::string printable(const std::string& s) {
-  std::string out;
-  for (std::size_t i = 0; i < s.size() && i < 80; ++i) {
-    const unsigned char c = static_cast<unsigned char>(s[i]);
-    out += c >= 0x20 && c < 0x7f ? std::string(1, static_cast<char>(c)) : fmt::format("\\x{:02x}", c);
-  }
-  return s.size() > 80 ? out + fmt::format("... ({} bytes)", s.size()) : out;
+// A name as a message may print it: at most 80 bytes of it.
+std::string short_name(const std::string& s) {
+  return s.size() > 80 ? s.substr(0, 80) + fmt::format("... ({} bytes)", s.size()) : s;
 }
 
 const std::vector<std::string_view> kSensorNames = {"landmarks", "lead_projection", "altimeter",
@@ -146,7 +141,7 @@ void parse_uavs(const Ctx& ctx, const Field& f, std::vector<UavSpec>& uavs, Prov
       ctx.fail(name_loc, "'lead' is reserved for the lead agent; choose another UAV name");
     if (!name_ok(u.name, false))
       ctx.fail(name_loc, fmt::format("UAV names must match [a-z0-9_]+ and be at most {} characters, got '{}'",
-                                     kMaxNameLength, printable(u.name)));
+                                     kMaxNameLength, short_name(u.name)));
     for (std::size_t j = 0; j < uavs.size(); ++j) {
       if (uavs[j].name == u.name)
         ctx.fail(name_loc, fmt::format("duplicate UAV name '{}' (first at line {})", u.name,
@@ -185,7 +180,7 @@ void parse_phases(const Ctx& ctx, const Field& f, std::vector<Phase>& phases, Pr
     if (nf) p.name = read_string(ctx, *nf);
     if (nf && !scenario_name_ok(p.name))
       ctx.fail(nf->loc(), fmt::format("phase names must match [A-Za-z0-9_.-]+ and be at most {} characters, "
-                                      "got '{}'", kMaxNameLength, printable(p.name)));
+                                      "got '{}'", kMaxNameLength, short_name(p.name)));
     const Field from = m.require("from", item.loc());
     const Field to = m.require("to", item.loc());
     read_window(ctx, from, to, p.t_start, p.t_end);
@@ -258,7 +253,10 @@ void parse_control_uavs(const Ctx& ctx, const Field& f, std::vector<UavControlSp
         ctx.fail(nf.loc(), fmt::format("duplicate UAV '{}' (first at line {})", u.uav,
                                        name_locs[j].mark.line + 1));
     num(ctx, m, "initial_yaw", u.initial_yaw, in(-2 * M_PI, 2 * M_PI));
-    set_if(m, "lambda_d", u.lambda_d, [&](const Field& x) { return read_vec3(ctx, x); });
+    // The formation's offset from the lead: within the world's bounds (sim/budget.hpp).
+    set_if(m, "lambda_d", u.lambda_d, [&](const Field& x) {
+      return read_vec3(ctx, x, in(-RunLimits::kMaxCoordinate, RunLimits::kMaxCoordinate));
+    });
     if (auto y = m.get("yaw_d")) {
       if (y->node.IsScalar() && y->node.Scalar() == "lead_bearing")
         u.yaw_d.reset();
@@ -351,6 +349,9 @@ void check_budget(const Ctx& ctx, const Scenario& s, const Provenance& prov) {
   if (!(e.extent_m <= 2 * L::kMaxCoordinate))
     ctx.fail(key_loc(prov, "lead.trajectory." + traj),
              fmt::format("the flight spans {:.3g} m; at most {:.3g}", e.extent_m, 2 * L::kMaxCoordinate));
+  if (!(e.max_abs_z_m <= L::kMaxCoordinate))
+    ctx.fail(key_loc(prov, "lead.trajectory.z_amplitude"),
+             fmt::format("the flight reaches {:.3g} m from z = 0; at most {:.3g}", e.max_abs_z_m, L::kMaxCoordinate));
   const bool rendered = s.measurements == MeasurementMode::Rendered;
   if (!rendered && !(e.landmarks <= L::kMaxLandmarks))
     ctx.fail(key_loc(prov, "landmarks.density"),
@@ -441,7 +442,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
     if (!scenario_name_ok(base.name))
       ctx.fail(f->loc(), fmt::format("the scenario's name names its results directory: it must match "
                                      "[A-Za-z0-9_.-]+, not start with '.' or '-', and be at most {} "
-                                     "characters, got '{}'", kMaxNameLength, printable(base.name)));
+                                     "characters, got '{}'", kMaxNameLength, short_name(base.name)));
   }
   num(ctx, top, "rate", base.rate, in(0, 1000, true, false));
   if (auto f = top.get("rate")) prov.keys["rate"] = f->loc();
@@ -485,7 +486,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
     const std::string name = read_string(ctx, nf);
     if (!name_ok(name, true))
       ctx.fail(nf.loc(), fmt::format("variant names must match [a-z0-9_-]+ and be at most {} characters, got '{}'",
-                                     kMaxNameLength, printable(name)));
+                                     kMaxNameLength, short_name(name)));
     for (std::size_t j = 0; j < out.size(); ++j) {
       if (out[j].variant == name)
         ctx.fail(nf.loc(), fmt::format("duplicate variant name '{}' (first at line {})", name,

@@ -32,7 +32,28 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 }
 }  // namespace
 
-void Ctx::fail(const YAML::Mark& m, const std::string& path, const std::string& what) const {
+namespace {
+std::size_t utf8_sequence(const std::string& s, std::size_t i);
+}  // namespace
+
+std::string printable(const std::string& s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    const std::size_t n = utf8_sequence(s, i);
+    if (n == 0 || c < 0x20 || c == 0x7f) {
+      out += fmt::format("\\x{:02x}", c);
+      ++i;
+    } else {
+      out.append(s, i, n);
+      i += n;
+    }
+  }
+  return out;
+}
+
+void Ctx::fail(const YAML::Mark& m, const std::string& path, const std::string& raw_what) const {
+  const std::string what = printable(raw_what);  // a message never echoes raw bytes of the input
   std::string where = origin_;
   if (!m.is_null() && m.line >= 0) where += fmt::format(":{}:{}", m.line + 1, m.column + 1);
   if (path.empty()) throw ScenarioError(fmt::format("{}: {}", where, what));
@@ -163,6 +184,10 @@ double read_number(const Ctx& ctx, const Field& f, Bounds b) {
     ctx.fail(f.loc(), fmt::format("expected a number, got '{}'", s));
   if (!std::isfinite(v)) ctx.fail(f.loc(), fmt::format("expected a finite number, got '{}'", s));
   if (!b.ok(v)) ctx.fail(f.loc(), fmt::format("must be {}, got {}", bounds_text(b), s));
+  // No setting is a physical quantity this large; a value past it is a typo or a probe, and
+  // would turn into inf or NaN somewhere in the run.
+  if (std::abs(v) > kMaxMagnitude && !(std::isfinite(b.hi) && std::abs(v) <= std::abs(b.hi)))
+    ctx.fail(f.loc(), fmt::format("{} is beyond any setting's scale (magnitude at most {:g})", s, kMaxMagnitude));
   return v;
 }
 
@@ -221,21 +246,28 @@ bool read_bool(const Ctx& ctx, const Field& f) {
 
 namespace {
 
-// Well-formed UTF-8 (no overlong forms, surrogates or code points past U+10FFFF).
+// Length of the well-formed UTF-8 sequence at s[i] (no overlong forms, surrogates or code points
+// past U+10FFFF), or 0.
+std::size_t utf8_sequence(const std::string& s, std::size_t i) {
+  const unsigned char c = static_cast<unsigned char>(s[i]);
+  const int n = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xe ? 2 : (c >> 3) == 0x1e ? 3 : -1;
+  if (n < 0 || i + n >= s.size()) return 0;
+  std::uint32_t cp = n == 0 ? c : c & (0x3f >> n);
+  for (int k = 1; k <= n; ++k) {
+    const unsigned char d = static_cast<unsigned char>(s[i + k]);
+    if ((d >> 6) != 0x2) return 0;
+    cp = (cp << 6) | (d & 0x3f);
+  }
+  const std::uint32_t min[] = {0, 0x80, 0x800, 0x10000};
+  if (cp < min[n] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return 0;
+  return static_cast<std::size_t>(n) + 1;
+}
+
 bool valid_utf8(const std::string& s) {
   for (std::size_t i = 0; i < s.size();) {
-    const unsigned char c = static_cast<unsigned char>(s[i]);
-    const int n = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xe ? 2 : (c >> 3) == 0x1e ? 3 : -1;
-    if (n < 0 || i + n >= s.size()) return false;
-    std::uint32_t cp = n == 0 ? c : c & (0x3f >> n);
-    for (int k = 1; k <= n; ++k) {
-      const unsigned char d = static_cast<unsigned char>(s[i + k]);
-      if ((d >> 6) != 0x2) return false;
-      cp = (cp << 6) | (d & 0x3f);
-    }
-    const std::uint32_t min[] = {0, 0x80, 0x800, 0x10000};
-    if (cp < min[n] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return false;
-    i += n + 1;
+    const std::size_t n = utf8_sequence(s, i);
+    if (n == 0) return false;
+    i += n;
   }
   return true;
 }

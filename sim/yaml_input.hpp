@@ -30,6 +30,9 @@ struct Loc {
   bool valid() const { return !path.empty(); }
 };
 
+// Text as a message may print it: control characters and bytes outside well-formed UTF-8 as \xNN.
+std::string printable(const std::string& s);
+
 // The file being read; its fail() throws ScenarioError (sim/scenario.hpp) with the position.
 class Ctx {
  public:
@@ -100,6 +103,8 @@ long long read_integer(const Ctx& ctx, const Field& f, long long lo, long long h
 int read_int(const Ctx& ctx, const Field& f, int lo, int hi = std::numeric_limits<int>::max());
 std::uint64_t read_seed(const Ctx& ctx, const Field& f);
 bool read_bool(const Ctx& ctx, const Field& f);
+// Numbers without an upper bound of their own are at most this large in magnitude.
+inline constexpr double kMaxMagnitude = 1e9;
 // Strings (names, file paths) are UTF-8 and at most this long.
 inline constexpr std::size_t kMaxStringBytes = 4096;
 std::string read_string(const Ctx& ctx, const Field& f);

@@ -99,7 +99,7 @@ struct GatingSettings {
     v("one_point_ransac", one_point_ransac);
     v("ransac_inlier_px", ransac_inlier_px, gt(0));
     v("ransac_success_probability", ransac_success_probability, in(0, 1));
-    v("ransac_max_hypotheses", ransac_max_hypotheses, ge(1));
+    v("ransac_max_hypotheses", ransac_max_hypotheses, in(1, 100000));
   }
 };
 
@@ -111,8 +111,9 @@ struct MapSettings {
 
   template <class V>
   void visit(V& v) {
-    v("max_landmarks", max_landmarks, ge(1));
-    v("target_per_camera", target_per_camera, ge(1));
+    // The filter's covariance grows as (6 max_landmarks)^2 doubles: 2000 is 1.2 GB a copy.
+    v("max_landmarks", max_landmarks, in(1, 2000));
+    v("target_per_camera", target_per_camera, in(1, 2000));
     v("max_misses", max_misses, ge(1));
     v("image_margin_px", image_margin_px, ge(0));
   }

@@ -44,11 +44,11 @@ struct FeatureSettings {
     v.choice("detector", kind,
              {{"orb", DetectorKind::Orb}, {"akaze", DetectorKind::Akaze}, {"sift", DetectorKind::Sift},
               {"gftt_orb", DetectorKind::GfttOrb}});
-    v("max_features", max_features, geometry::ge(1));
+    v("max_features", max_features, geometry::in(1, 100000));
     v.pair("grid", grid_cols, grid_rows, geometry::ge(1));  // [columns, rows]
     v.section("orb", [&](auto& o) {
       o("fast_threshold", orb_fast_threshold, geometry::ge(1));
-      o("levels", orb_levels, geometry::ge(1));
+      o("levels", orb_levels, geometry::in(1, 16));
       o("scale_factor", orb_scale_factor, geometry::in(1, 2, true, false));
     });
     v.section("akaze", [&](auto& a) { a("threshold", akaze_threshold, geometry::gt(0)); });

@@ -72,7 +72,7 @@ TEST(ControlSpec, Errors) {
   EXPECT_THAT(error_of("control:\n  gains: 1\n"),
               HasSubstr("cl.yaml:2:3: control.gains: unknown key 'gains'"));
   EXPECT_THAT(error_of("control:\n  k2: [1, 0, 1, 1]\n"),
-              HasSubstr("cl.yaml:2:11: control.k2[1]: must be > 0, got 0"));
+              HasSubstr("cl.yaml:2:11: control.k2[1]: must be in (0, 1000], got 0"));
   EXPECT_THAT(error_of("control:\n  k1: [1, 1, 1]\n"),
               HasSubstr("control.k1: expected a number or a list of 4 numbers"));
   EXPECT_THAT(error_of("control:\n  switching: sgn\n"),
@@ -84,7 +84,7 @@ TEST(ControlSpec, Errors) {
   EXPECT_THAT(error_of("control:\n  uavs:\n    - {name: uav1}\n    - {name: uav2}\n    - {name: uav7}\n"),
               HasSubstr("'uav7' is not a UAV of this scenario"));
   EXPECT_THAT(error_of("control:\n  limits: {yaw_rate: -1}\n"),
-              HasSubstr("control.limits.yaw_rate: must be > 0, got -1"));
+              HasSubstr("control.limits.yaw_rate: must be in (0, 10], got -1"));
   EXPECT_THAT(error_of("estimator: {mode: single}\ncontrol: {}\n"),
               HasSubstr("closed loop (the control: section) needs mode multi"));
 }

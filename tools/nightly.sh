@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The nightly check, too long for every CI run: the whole test suite under AddressSanitizer and
+# UndefinedBehaviorSanitizer (undefined behaviour aborts), then the input fuzz campaign of
+# docs/reliability.md against that sanitized binary.
+#   tools/nightly.sh [BUILD_DIR]      (default build-asan; about an hour on 2 cores)
+set -euo pipefail
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build=${1:-$here/build-asan}
+cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DWINGMAN_ASAN=ON >/dev/null
+cmake --build "$build" -j "$(nproc)"
+(cd "$build" && ctest -j "$(nproc)" --output-on-failure)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+# ASan reserves a large virtual address space: the fuzzer's memory cap must leave room for it.
+python3 "$here/tools/fuzz_inputs.py" --wingman "$build/app/wingman" --workdir "$work/fuzz" \
+  --scenario-mutants 2000 --dataset-corruptions 300 --jobs "$(nproc)" --mem-gib 0 --timeout 300
