@@ -18,7 +18,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopencv-dev libopencv-contrib-dev libassimp-dev zlib1g-dev
   libegl-dev libgl-dev libosmesa6-dev libegl-mesa0 libgl1-mesa-dri
-  gnuplot-nox
+  gnuplot-nox python3 python3-yaml
 )
 
 install_packages() {

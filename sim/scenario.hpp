@@ -145,22 +145,24 @@ struct NoiseSpec {
 
   template <class V>
   void visit(V& v) {
-    v("pixel_sigma", pixel_sigma, geometry::ge(0));
-    v("pixel_bias_sigma", pixel_bias_sigma, geometry::ge(0));
-    v("gps_sigma", gps_sigma, geometry::ge(0));
-    v("altimeter_sigma", altimeter_sigma, geometry::ge(0));
-    v("range_sigma", range_sigma, geometry::ge(0));
-    v("ahrs_yaw_sigma", ahrs_yaw_sigma, geometry::ge(0));
+    // Past these a sensor measures nothing (a pixel error larger than any image, a GPS error of
+    // 10 km), and the filter's covariance can no longer stay positive definite in double precision.
+    v("pixel_sigma", pixel_sigma, geometry::in(0, 1000));
+    v("pixel_bias_sigma", pixel_bias_sigma, geometry::in(0, 1000));
+    v("gps_sigma", gps_sigma, geometry::in(0, 1e4));
+    v("altimeter_sigma", altimeter_sigma, geometry::in(0, 1e4));
+    v("range_sigma", range_sigma, geometry::in(0, 1e4));
+    v("ahrs_yaw_sigma", ahrs_yaw_sigma, geometry::in(0, 10));
     v("outlier_fraction", outlier_fraction, geometry::in(0, 1));
     v("cooperative_outlier_fraction", cooperative_outlier_fraction, geometry::in(0, 1));
-    v("outlier_max_px", outlier_max_px, geometry::ge(0));
+    v("outlier_max_px", outlier_max_px, geometry::in(0, 1e5));
     v("gimbal_amplitude", gimbal_amplitude);
     v("gimbal_omega", gimbal_omega);
     v("gimbal_random_phase", gimbal_random_phase);
     v.section("motion", [&](auto& m) {
-      m("accel_sigma_lead", motion.accel_sigma_lead, geometry::ge(0));
-      m("accel_sigma_uav", motion.accel_sigma_uav, geometry::ge(0));
-      m("accel_sigma_common", motion.accel_sigma_common, geometry::ge(0));
+      m("accel_sigma_lead", motion.accel_sigma_lead, geometry::in(0, 100));
+      m("accel_sigma_uav", motion.accel_sigma_uav, geometry::in(0, 100));
+      m("accel_sigma_common", motion.accel_sigma_common, geometry::in(0, 100));
     });
   }
 };

@@ -31,9 +31,9 @@ struct ProcessNoiseSettings {
 
   template <class V>
   void visit(V& v) {
-    v("accel_sigma_lead", accel_sigma_lead, ge(0));
-    v("accel_sigma_uav", accel_sigma_uav, ge(0));
-    v("accel_sigma_common", accel_sigma_common, ge(0));
+    v("accel_sigma_lead", accel_sigma_lead, in(0, 100));
+    v("accel_sigma_uav", accel_sigma_uav, in(0, 100));
+    v("accel_sigma_common", accel_sigma_common, in(0, 100));
     v.section("common_acceleration_state", [&](auto& c) {
       c("sigma", common_state_sigma, ge(0));
       c("time_constant", common_state_time_constant, ge(0));
@@ -58,12 +58,13 @@ struct MeasurementNoiseSettings {
 
   template <class V>
   void visit(V& v) {
-    v("pixel_sigma", pixel_sigma, ge(0));
-    v("pixel_offset_sigma", pixel_offset_sigma, ge(0));
-    v("gps_sigma", gps_sigma, ge(0));
-    v("altimeter_sigma", altimeter_sigma, ge(0));
-    v("range_sigma", range_sigma, ge(0));
-    v("orientation_sigma", orientation_sigma, ge(0));
+    // The same ranges as the truth's noise (sim/scenario.hpp), for the same reason.
+    v("pixel_sigma", pixel_sigma, in(0, 1000));
+    v("pixel_offset_sigma", pixel_offset_sigma, in(0, 1000));
+    v("gps_sigma", gps_sigma, in(0, 1e4));
+    v("altimeter_sigma", altimeter_sigma, in(0, 1e4));
+    v("range_sigma", range_sigma, in(0, 1e4));
+    v("orientation_sigma", orientation_sigma, in(0, 1));
     v("orientation_time_constant", orientation_time_constant, ge(0));
   }
 };

@@ -648,9 +648,11 @@ class Case:
 
 
 def memory_cap(limit: int):
-    """preexec_fn: the address-space cap, set in the child between fork and exec."""
+    """preexec_fn: the address-space cap, set in the child between fork and exec (0: none, for a
+    sanitized binary, whose shadow memory needs terabytes of address space)."""
     def apply():
-        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+        if limit > 0:
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
     return apply
 
 
@@ -882,7 +884,7 @@ def parse_args(argv=None):
                     help="seconds after which no new run starts")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--timeout", type=float, default=60, help="seconds per run")
-    ap.add_argument("--mem-gib", type=float, default=4, help="address-space cap per run, GiB")
+    ap.add_argument("--mem-gib", type=float, default=4, help="address-space cap per run, GiB (0: none)")
     ap.add_argument("--dataset", help="dataset to corrupt (default: rendered once into WORKDIR)")
     opts = ap.parse_args(argv)
     opts.wingman = str(Path(opts.wingman).resolve())

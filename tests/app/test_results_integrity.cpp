@@ -131,14 +131,14 @@ TEST(ResultsIntegrity, NumericalFailureOfTheFilterIsAnErrorAtItsStep) {
   EXPECT_FALSE(fs::exists(out));
   EXPECT_THAT(leftovers(tmp.path(), "res"), IsEmpty());
 
-  // Truth noise no filter can follow: the first non-finite value is named, never written.
+  // Noise no sensor has is refused before the run, rather than breaking the filter during it.
   text = read_file(kSmoke);
-  replace_once(text, "  pixel_sigma: 3\n", "  pixel_sigma: 1e300\n");
+  replace_once(text, "  pixel_sigma: 3\n", "  pixel_sigma: 1e6\n");
   write_file(tmp / "px.yaml", text);
   const RunResult p = run_wingman({"run", (tmp / "px.yaml").string(), "--out", out.string(), "--no-plots", "-q"},
                                   tmp.path());
-  EXPECT_EQ(p.exit_code, 1) << p.output;
-  EXPECT_THAT(p.output, HasSubstr("px.yaml: step 1 (t = 0.1 s; camera 0 is uav1): numerical failure"));
+  EXPECT_EQ(p.exit_code, 2) << p.output;
+  EXPECT_THAT(p.output, HasSubstr("px.yaml:28:16: noise.pixel_sigma: must be in [0, 1000], got 1e6"));
   EXPECT_FALSE(fs::exists(out));
 }
 

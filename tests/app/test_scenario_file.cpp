@@ -328,7 +328,7 @@ uavs:
   EXPECT_THAT(error_of("lead: {trajectory: {type: circle}}\n"),
               HasSubstr("lead.trajectory.type: expected one of lemniscate, line, got 'circle'"));
   EXPECT_THAT(error_of("noise: {motion: {accel_sigma_lead: -0.1}}\n"),
-              HasSubstr("noise.motion.accel_sigma_lead: must be >= 0, got -0.1"));
+              HasSubstr("noise.motion.accel_sigma_lead: must be in [0, 100], got -0.1"));
   EXPECT_THAT(error_of("noise: {motion: {accel_sigma: 0.1}}\n"),
               HasSubstr("scn.yaml:1:18: noise.motion.accel_sigma: unknown key 'accel_sigma'"));
 }
@@ -363,7 +363,7 @@ estimator:
   EXPECT_THAT(error_of("seed: -1\n"), HasSubstr("seed: must be >= 0, got -1"));
   EXPECT_EQ(parse_scenarios("seed: 18446744073709551615\n", "x.yaml")[0].seed,
             18446744073709551615ull);
-  EXPECT_THAT(error_of("noise: {gps_sigma: -0.1}\n"), HasSubstr("noise.gps_sigma: must be >= 0"));
+  EXPECT_THAT(error_of("noise: {gps_sigma: -0.1}\n"), HasSubstr("noise.gps_sigma: must be in [0, 10000]"));
   EXPECT_THAT(error_of("noise: {outlier_fraction: 1.5}\n"),
               HasSubstr("noise.outlier_fraction: must be in [0, 1], got 1.5"));
   EXPECT_THAT(error_of("landmarks: {density: 0}\n"), HasSubstr("landmarks.density: must be > 0"));
@@ -536,10 +536,11 @@ TEST(ScenarioYaml, RunSizeIsBoundedByWhatItDrives) {
   EXPECT_THAT(error_of("measurements: rendered\nworld: {terrain: {extent: 1e6}}\n"),
               HasSubstr("world.terrain.extent: the terrain mesh would have 2.5e+11 vertices"));
   // Keys without a size of their own are still bounded: no setting is 1e308 of anything.
-  EXPECT_THAT(error_of("noise: {gps_sigma: 1e308}\n"),
-              HasSubstr("noise.gps_sigma: 1e308 is beyond any setting's scale (magnitude at most 1e+09)"));
+  EXPECT_THAT(error_of("noise: {gimbal_omega: 1e308}\n"),
+              HasSubstr("noise.gimbal_omega: 1e308 is beyond any setting's scale (magnitude at most 1e+09)"));
+  EXPECT_THAT(error_of("noise: {gps_sigma: 1e308}\n"), HasSubstr("noise.gps_sigma: must be in [0, 10000], got 1e308"));
   EXPECT_THAT(error_of("estimator: {process_noise: {accel_sigma_common: 1e300}}\n"),
-              HasSubstr("estimator.process_noise.accel_sigma_common: 1e300 is beyond any setting's scale"));
+              HasSubstr("estimator.process_noise.accel_sigma_common: must be in [0, 100], got 1e300"));
   EXPECT_THAT(error_of("estimator: {map: {max_landmarks: 100000}}\n"), HasSubstr("estimator.map.max_landmarks: must be"));
   EXPECT_THAT(error_of("frontend: {max_features: 10000000}\n"), HasSubstr("frontend.max_features: must be in [1, 100000]"));
   EXPECT_THAT(error_of("lead: {trajectory: {z_amplitude: 1e8}}\n"),
