@@ -9,6 +9,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <random>
 #include <thread>
 
 #include "app_test_support.hpp"
@@ -198,6 +199,54 @@ TEST(ResultsIntegrity, KilledMonteCarloTakesItsWorkersWithIt) {
   for (int i = 0; i < 200 && !staging().empty(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_THAT(staging(), IsEmpty()) << "orphaned workers kept running";
   EXPECT_FALSE(fs::exists(out / "montecarlo.json"));
+}
+
+// A results directory that exists is complete: the marker, and every variant's metrics.json.
+bool complete(const fs::path& out) {
+  return fs::exists(out / ".wingman-results") && fs::exists(out / "multi" / "metrics.json") &&
+         fs::exists(out / "single" / "metrics.json");
+}
+
+// Signals at random times over a run's whole life (starting, computing, writing, committing),
+// onto a directory that already holds a result: whatever the moment, DIR is either the old result
+// or a complete new one, never missing or partial; the next run cleans up whatever was left.
+TEST(ResultsIntegrity, SignalsAtRandomTimesNeverLoseOrFakeAResult) {
+  TempDir tmp;
+  const fs::path out = tmp / "res";
+  ASSERT_EQ(run_wingman({"run", kSmoke.string(), "--out", out.string(), "--no-plots", "-q"}, tmp.path()).exit_code, 0);
+  std::mt19937 rng(2026);
+  std::uniform_int_distribution<int> delay_ms(0, 900);
+  const int signals[] = {SIGINT, SIGTERM, SIGKILL};
+  for (int trial = 0; trial < 12; ++trial) {
+    const int sig = signals[trial % 3];
+    const pid_t pid = fork();
+    if (pid == 0) {
+      const int fd = ::open("/dev/null", O_WRONLY);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      execl(kBinary.c_str(), "wingman", "run", kSmoke.c_str(), "--out", out.c_str(), "--no-plots", "-q", "--force",
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(rng)));
+    kill(pid, sig);
+    int st = 0;
+    waitpid(pid, &st, 0);
+    const bool finished = WIFEXITED(st) && WEXITSTATUS(st) == 0;
+    if (!finished && WIFEXITED(st)) {
+      EXPECT_EQ(WEXITSTATUS(st), 128 + sig) << "trial " << trial;
+    }
+    EXPECT_TRUE(complete(out)) << "trial " << trial << " (signal " << sig << "): the result is gone or partial";
+    // A handled signal leaves nothing of its own (a SIGKILL's leftovers wait for the next run).
+    if (sig != SIGKILL && WIFEXITED(st)) {
+      EXPECT_FALSE(fs::exists(tmp / ("res.partial-" + std::to_string(pid)))) << "trial " << trial;
+    }
+  }
+  const RunResult r = run_wingman({"run", kSmoke.string(), "--out", out.string(), "--no-plots", "-q", "--force"},
+                                  tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(complete(out));
+  EXPECT_THAT(leftovers(tmp.path(), "res"), IsEmpty());
 }
 
 }  // namespace

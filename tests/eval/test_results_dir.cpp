@@ -88,12 +88,18 @@ TEST(ResultsDir, ExistingResultsAreRefusedWithoutForce) {
   EXPECT_TRUE(fs::exists(later / "first.txt"));
 }
 
+// The pid of a process that has exited (and been reaped): what a killed writer leaves behind.
+pid_t a_dead_pid() {
+  const pid_t pid = fork();
+  if (pid == 0) _exit(0);
+  waitpid(pid, nullptr, 0);
+  return pid;
+}
+
 TEST(ResultsDir, StagingLeftByAKilledProcessIsRemovedAndNamed) {
   test::TempDir tmp;
   const fs::path final_dir = tmp.path() / "run";
-  const pid_t dead = fork();
-  if (dead == 0) _exit(0);
-  waitpid(dead, nullptr, 0);
+  const pid_t dead = a_dead_pid();
   const fs::path stale = tmp.path() / ("run.partial-" + std::to_string(dead));
   const fs::path live = tmp.path() / ("run.partial-" + std::to_string(getppid()));
   const fs::path unrelated = tmp.path() / "runs.partial-1";
@@ -111,9 +117,7 @@ TEST(ResultsDir, StagingLeftByAKilledProcessIsRemovedAndNamed) {
 TEST(ResultsDir, PreviousResultMovedAsideByAKilledProcessIsRestored) {
   test::TempDir tmp;
   const fs::path final_dir = tmp.path() / "run";
-  const pid_t dead = fork();
-  if (dead == 0) _exit(0);
-  waitpid(dead, nullptr, 0);
+  const pid_t dead = a_dead_pid();
   const fs::path old = tmp.path() / ("run.old-" + std::to_string(dead));
   fs::create_directories(old);
   touch(old / ResultsDir::kMarker, "wingman results directory\n");
