@@ -224,6 +224,18 @@ int montecarlo_command(const MonteCarloOptions& o) {
     return 128 + sig;
   }
 
+  // A run whose filter broke down and recorded it (estimator.on_numerical_failure: record) ends
+  // early: it is a failed seed, not one to aggregate.
+  std::erase_if(finished, [&](std::uint64_t seed) {
+    for (const auto& [label, sub] : variant_labels(scenarios)) {
+      const std::string why = eval::recorded_numerical_failure(sub.empty() ? run_dir(out, seed) : run_dir(out, seed) / sub);
+      if (why.empty()) continue;
+      failed.emplace_back(seed, why);
+      fmt::print(stderr, "run seed {} failed ({})\n", seed, why);
+      return true;
+    }
+    return false;
+  });
   std::sort(finished.begin(), finished.end());
   if (finished.empty()) {
     fmt::print(stderr, "error: every run failed; see the logs in {}\n", (out / "runs").string());

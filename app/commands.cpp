@@ -5,6 +5,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,15 @@
 #include "sim/yaml_input.hpp"
 
 namespace wingman::app {
+namespace {
+
+// The last word of a failed command, on stderr; never throws (stderr may be a closed pipe).
+void report(const char* prefix, const char* what) noexcept {
+  const std::string text = sim::printable(what);
+  std::fprintf(stderr, "%s%s\n", prefix, text.c_str());
+}
+
+}  // namespace
 
 int run_cli(int argc, char** argv) {
   CLI::App cli{"wingman: cooperative visual SLAM for UAV teams flying with a lead agent"};
@@ -53,19 +63,19 @@ int run_cli(int argc, char** argv) {
     for (const auto& c : commands)
       if (c.cli->parsed()) return c.run();
   } catch (const Interrupted& e) {
-    fmt::print(stderr, "\n{}\n", e.what());
+    report("\n", e.what());
     return e.exit_code();
   } catch (const sim::ScenarioError& e) {
-    fmt::print(stderr, "error: {}\n", sim::printable(e.what()));
+    report("error: ", e.what());
     return 2;
   } catch (const UsageError& e) {
-    fmt::print(stderr, "error: {}\n", sim::printable(e.what()));
+    report("error: ", e.what());
     return 2;
   } catch (const datasets::DatasetError& e) {  // a frame or file of a dataset that is bad input
-    fmt::print(stderr, "error: {}\n", sim::printable(e.what()));
+    report("error: ", e.what());
     return 2;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "error: {}\n", sim::printable(e.what()));
+    report("error: ", e.what());
     return 1;
   }
   return 0;

@@ -14,9 +14,11 @@ namespace {
 std::atomic<int> g_signal{0};
 extern "C" void on_interrupt(int sig) { g_signal = sig; }
 
-struct sigaction g_old_int {}, g_old_term {};
+struct sigaction g_old_int {}, g_old_term {}, g_old_pipe {};
 
-const char* signal_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal"; }
+const char* signal_name(int sig) {
+  return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : sig == SIGPIPE ? "SIGPIPE" : "a signal";
+}
 
 }  // namespace
 
@@ -32,11 +34,13 @@ InterruptGuard::InterruptGuard() {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, &g_old_int);
   sigaction(SIGTERM, &sa, &g_old_term);
+  sigaction(SIGPIPE, &sa, &g_old_pipe);  // `wingman run ... | head`: stop cleanly, not die half-way
 }
 
 InterruptGuard::~InterruptGuard() {
   sigaction(SIGINT, &g_old_int, nullptr);
   sigaction(SIGTERM, &g_old_term, nullptr);
+  sigaction(SIGPIPE, &g_old_pipe, nullptr);
 }
 
 void stop_with_parent() {

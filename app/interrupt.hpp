@@ -1,4 +1,4 @@
-// SIGINT and SIGTERM for the long commands (run, slam, render, bench-frontend): the handler only
+// SIGINT, SIGTERM (and SIGPIPE, a closed output pipe) for the long commands: the handler only
 // sets a flag; loops call throw_if_interrupted() between steps, so the exception unwinds through
 // the staging directories' destructors (nothing half-written stays) and run_cli exits 128 + signal
 // (130 for Ctrl-C, 143 for SIGTERM), as a shell reports a process the signal killed.

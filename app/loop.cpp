@@ -377,8 +377,13 @@ eval::RunRecord run_loop(const RunConfig& cfg, const sim::Truth& truth, Measurem
     try {
       run_step(run, source, hooks, k, t);
     } catch (const slam::NumericalFailure& e) {
-      throw slam::NumericalFailure(fmt::format("{}: step {} (t = {} s; {}): {}", cfg.source_path, k, t,
-                                               camera_legend(run.rec), e.what()));
+      const std::string what = fmt::format("{}: step {} (t = {} s; {}): {}", cfg.source_path, k, t,
+                                           camera_legend(run.rec), e.what());
+      if (cfg.estimator.on_numerical_failure == slam::OnNumericalFailure::Stop) throw slam::NumericalFailure(what);
+      // Record: the steps before it are the results; a partly recorded step is dropped.
+      if (static_cast<int>(run.rec.steps.size()) > k) run.rec.steps.resize(static_cast<std::size_t>(k));
+      run.rec.numerical_failure = {k, t, what};
+      break;
     }
     if (observer) observer(k, run.est.state());
     if (progress) progress(k, N);

@@ -303,6 +303,13 @@ BatchTest test_batches(const std::string& label, const RunSet& runs, std::size_t
   return bt;
 }
 
+std::string recorded_numerical_failure(const fs::path& run_dir) {
+  const json j = read_json_file(run_dir / "metrics.json");
+  const auto it = j.find("numerical_failure");
+  if (it == j.end() || it->is_null()) return "";
+  return it->value("message", std::string("numerical failure"));
+}
+
 void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs::path& dir,
                        const MonteCarloProvenance& prov) {
   json out = json::array();
@@ -369,8 +376,8 @@ void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs
     csv += fmt::format("{:.6f}", summaries.front().t[k]);
     for (const auto& m : summaries) {
       const double v = k < m.average_nees.size() ? m.average_nees[k] : kNaN;
-      csv += "," + (std::isfinite(v) ? fmt::format("{:.6g}", v) : "") + "," +
-             fmt::format("{:.6g},{:.6g}", m.lower, m.upper);
+      csv += fmt::format(",{},{:.6g},{:.6g}", std::isfinite(v) ? fmt::format("{:.6g}", v) : std::string(),
+                         m.lower, m.upper);
     }
     csv += "\n";
   }

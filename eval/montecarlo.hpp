@@ -116,6 +116,10 @@ MonteCarloSummary aggregate_runs(const std::string& label,
                                  const std::vector<std::filesystem::path>& run_dirs);
 MonteCarloSummary aggregate_runs(const std::string& label, const RunSet& runs);
 
+// The message of a run's recorded numerical failure (metrics.json's numerical_failure, see
+// estimator.on_numerical_failure), or "" when it has none. Such a run stops early: a failed seed.
+std::string recorded_numerical_failure(const std::filesystem::path& run_dir);
+
 // What montecarlo.json says about the study besides its summaries.
 struct MonteCarloProvenance {
   std::string scenario;       // the scenario file

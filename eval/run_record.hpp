@@ -137,6 +137,13 @@ struct RunRecord {
   std::vector<OutlierCounts> outliers;
   FrontendRecord frontend;
   double wall_time_s = 0;
+  // The filter's numerical breakdown (estimator.on_numerical_failure: record): the steps end
+  // before it; empty message when none.
+  struct NumericalFailure {
+    int step = 0;
+    double t = 0;
+    std::string message;
+  } numerical_failure;
   // Closed loop (section 6): the controlled UAVs and when formation metrics start in a phase.
   bool closed_loop = false;
   std::vector<std::string> formation_uavs;

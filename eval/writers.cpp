@@ -184,6 +184,9 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
   j["closed_loop"] = run.closed_loop;
   j["wall_time_s"] = num(run.wall_time_s);
   j["steps"] = run.steps.size();
+  const auto& nf = run.numerical_failure;
+  j["numerical_failure"] = nf.message.empty() ? json(nullptr)
+                                              : json{{"step", nf.step}, {"t", nf.t}, {"message", nf.message}};
   write_file(path, j.dump(2) + "\n");
 }
 
@@ -339,6 +342,8 @@ std::string format_summary(const Metrics& m, const RunRecord& run) {
                  run.variant.empty() ? "-" : run.variant, run.seed,
                  run.estimator_mode.empty() ? "-" : run.estimator_mode, run.steps.size(),
                  run.wall_time_s);
+  if (!run.numerical_failure.message.empty())
+    fmt::format_to(out, "NUMERICAL FAILURE, the results end before it: {}\n", run.numerical_failure.message);
 
   // Table 4: MSE per axis, then the error norm (RMS / max) per agent.
   fmt::format_to(out, "\nTable 4: position MSE [m^2]\n{:<{}}", "phase", nw);

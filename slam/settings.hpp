@@ -151,9 +151,14 @@ struct InitialisationSettings {
   }
 };
 
+// What a run does when the filter breaks down numerically (slam/health.hpp): stop with an error
+// and write nothing, or record the failure in metrics.json and write the steps before it.
+enum class OnNumericalFailure { Stop, Record };
+
 struct EstimatorSettings {
   // Default: multi with two UAVs or more, single with one (the scenario reader decides).
   EstimatorMode mode = EstimatorMode::MultiUav;
+  OnNumericalFailure on_numerical_failure = OnNumericalFailure::Stop;
   std::string single_uav = "uav1";  // whose camera the single-UAV baseline uses
   ProcessNoiseSettings process_noise{};
   MeasurementNoiseSettings measurement_noise{};
@@ -166,6 +171,8 @@ struct EstimatorSettings {
   void visit(V& v) {
     v.choice("mode", mode, {{"multi", EstimatorMode::MultiUav}, {"single", EstimatorMode::SingleUav}});
     v("single_uav", single_uav);
+    v.choice("on_numerical_failure", on_numerical_failure,
+             {{"stop", OnNumericalFailure::Stop}, {"record", OnNumericalFailure::Record}});
     v.section("process_noise", [&](auto& s) { process_noise.visit(s); });
     v.section("measurement_noise", [&](auto& s) { measurement_noise.visit(s); });
     v.section("initial_sigma", [&](auto& s) { initial_sigma.visit(s); });

@@ -12,6 +12,8 @@
 #include <random>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "app_test_support.hpp"
 
 namespace wingman::app::test {
@@ -131,6 +133,23 @@ TEST(ResultsIntegrity, NumericalFailureOfTheFilterIsAnErrorAtItsStep) {
   EXPECT_THAT(r.output, HasSubstr("camera 0 is uav1"));
   EXPECT_FALSE(fs::exists(out));
   EXPECT_THAT(leftovers(tmp.path(), "res"), IsEmpty());
+
+  // Asked to record instead: the steps before the failure are the results, and say so.
+  text = read_file(tmp / "gps.yaml");
+  replace_once(text, "  single_uav: uav1\n", "  single_uav: uav1\n  on_numerical_failure: record\n");
+  write_file(tmp / "rec.yaml", text);
+  const RunResult rec = run_wingman(
+      {"run", (tmp / "rec.yaml").string(), "--out", out.string(), "--no-plots", "--variant", "multi"}, tmp.path());
+  EXPECT_EQ(rec.exit_code, 0) << rec.output;
+  EXPECT_THAT(rec.output, HasSubstr("NUMERICAL FAILURE, the results end before it: "));
+  const auto metrics = nlohmann::json::parse(read_file(out / "multi" / "metrics.json"));
+  ASSERT_TRUE(metrics["numerical_failure"].is_object()) << metrics["numerical_failure"];
+  const int step = metrics["numerical_failure"]["step"];
+  EXPECT_GT(step, 1);
+  EXPECT_EQ(metrics["steps"], step);  // steps 0 .. step - 1
+  EXPECT_THAT(metrics["numerical_failure"]["message"].get<std::string>(), HasSubstr("numerical failure in the filter"));
+  EXPECT_EQ(lines_of(read_file(out / "multi" / "steps.csv")).size(), static_cast<std::size_t>(step) + 1);
+  fs::remove_all(out);
 
   // Noise no sensor has is refused before the run, rather than breaking the filter during it.
   text = read_file(kSmoke);
