@@ -11,9 +11,9 @@
 
 #include "app/interrupt.hpp"
 #include "app/timing.hpp"
-#include "slam/health.hpp"
 #include "app/version.hpp"
 #include "sim/rng.hpp"
+#include "slam/health.hpp"
 
 namespace wingman::app {
 

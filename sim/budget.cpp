@@ -41,6 +41,14 @@ Eigen::Vector4d sampled_extent(const Scenario& s, double& max_abs_z) {
     grow(s.lead.initial_position);
     for (const auto& u : s.uavs) grow(u.initial_position);
   }
+  if (s.control.enabled) {
+    // Closed loop: the field covers a circle around the lead as wide as the farthest UAV may be
+    // (ClosedLoopTruth::horizontal_extent): its initial offset or lambda_d, plus 10 m.
+    double r = 0;
+    for (const auto& u : s.uavs) r = std::max(r, (u.initial_position - s.lead.initial_position).head<2>().norm());
+    for (const auto& c : s.control.uavs) r = std::max(r, c.lambda_d.head<2>().norm());
+    box += Eigen::Vector4d(-r - 10, -r - 10, r + 10, r + 10);
+  }
   return box;
 }
 

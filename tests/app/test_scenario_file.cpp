@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "app/run_config.hpp"
@@ -562,6 +563,20 @@ std::string load_error(const std::string& path) {
   }
   ADD_FAILURE() << "expected a ScenarioError for " << path;
   return "";
+}
+
+// In closed loop the landmark field covers the circle the formation may fly in: a lambda_d of
+// 90 km is counted before the field is built (it would have held 6.5e8 points, 15 GB).
+TEST(ScenarioFile, ClosedLoopFormationOffsetsCountInTheLandmarkField) {
+  std::ifstream in(WINGMAN_SOURCE_DIR "/scenes/paper_closed_loop_synthetic.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const auto at = yaml.find("lambda_d: [2.5, 1, 14]");
+  ASSERT_NE(at, std::string::npos);
+  yaml.replace(at, 22, "lambda_d: [90000, 1, 14]");
+  EXPECT_THAT(error_of(yaml, "cl.yaml"), HasSubstr("landmarks.density"));
+  EXPECT_THAT(error_of(yaml, "cl.yaml"), HasSubstr("landmarks; at most 5e+06"));
 }
 
 TEST(ScenarioFile, OversizedOrBinaryFilesAreRefusedBeforeParsing) {
