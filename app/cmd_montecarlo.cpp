@@ -187,10 +187,9 @@ void open_study(const MonteCarloOptions& o, const fs::path& out, const std::vect
     }
   }
   const std::string settings = study_settings(scenarios, o.limit);
-  if (fs::exists(out / kStudySettingsFile)) record_or_check_study(out, settings);
+  record_or_check_study(out, settings);  // refuses before anything is created or changed
   fs::create_directories(out / "runs");
   eval::write_file_atomic(out / kMarker, o.scenario + "\n");
-  record_or_check_study(out, settings);
   // Staging directories of workers that were stopped: never complete; dropped once their process is gone.
   for (const auto& note : eval::ResultsDir::remove_stale_staging(out / "runs"))
     if (!o.quiet) fmt::print(stderr, "note: {}\n", note);

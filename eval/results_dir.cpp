@@ -43,6 +43,16 @@ long sibling_pid(const std::string& name, const std::string& prefix) {
   return std::stol(digits);
 }
 
+// A staging directory of process `pid`: left to it while it runs, removed once it is gone (it is
+// never complete). Returns the note saying which.
+std::string drop_unless_running(const fs::path& dir, long pid) {
+  if (process_alive(pid))
+    return dir.string() + " is being written by process " + std::to_string(pid) + ", which is still running; left alone";
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  return "removed " + dir.string() + ", left by process " + std::to_string(pid) + ", which is gone";
+}
+
 // Leftovers of processes killed while writing final_dir (SIGKILL, power loss): a staging
 // directory is never complete and goes; a moved-aside old directory is a previous result and is
 // put back when nothing replaced it.
@@ -55,17 +65,12 @@ std::vector<std::string> clean_leftovers(const fs::path& final_dir) {
     for (const char* tag : {kPartial, kOld}) {
       const long pid = sibling_pid(name, leaf + tag);
       if (pid < 0) continue;
-      if (process_alive(pid)) {
-        notes.push_back(e.path().string() + " is being written by process " + std::to_string(pid) +
-                        ", which is still running; left alone");
-      } else if (tag == kOld && !fs::exists(fs::symlink_status(final_dir, ec))) {
+      if (tag == kOld && !process_alive(pid) && !fs::exists(fs::symlink_status(final_dir, ec))) {
         fs::rename(e.path(), final_dir, ec);
         notes.push_back("restored " + final_dir.string() + " from " + name + " (process " +
                         std::to_string(pid) + " was killed while replacing it)");
       } else {
-        fs::remove_all(e.path(), ec);
-        notes.push_back("removed " + e.path().string() + ", left by process " + std::to_string(pid) +
-                        ", which is gone");
+        notes.push_back(drop_unless_running(e.path(), pid));
       }
     }
   }
@@ -103,14 +108,7 @@ std::vector<std::string> ResultsDir::remove_stale_staging(const fs::path& dir) {
     if (at == std::string::npos || at == 0) continue;
     const long pid = sibling_pid(name, name.substr(0, at) + kPartial);
     if (pid < 0) continue;
-    if (process_alive(pid)) {
-      notes.push_back(e.path().string() + " is being written by process " + std::to_string(pid) +
-                      ", which is still running; left alone");
-    } else {
-      fs::remove_all(e.path(), ec);
-      notes.push_back("removed " + e.path().string() + ", left by process " + std::to_string(pid) +
-                      ", which is gone");
-    }
+    notes.push_back(drop_unless_running(e.path(), pid));
   }
   return notes;
 }
