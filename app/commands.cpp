@@ -13,6 +13,7 @@
 #include "app/subcommand.hpp"
 #include "app/version.hpp"
 #include "datasets/dataset.hpp"
+#include "eval/metric_set.hpp"
 #include "sim/scenario.hpp"
 #include "sim/yaml_input.hpp"
 
@@ -39,6 +40,8 @@ int run_cli(int argc, char** argv) {
       add_render(cli),
       add_slam(cli),
       add_bench_frontend(cli),
+      add_baseline(cli),
+      add_check(cli),
   };
 
   // A first word that is neither an option nor a command: say so and list the commands.
@@ -69,6 +72,9 @@ int run_cli(int argc, char** argv) {
     report("error: ", e.what());
     return 2;
   } catch (const UsageError& e) {
+    report("error: ", e.what());
+    return 2;
+  } catch (const eval::CheckInputError& e) {  // a baseline, a results directory that is bad input
     report("error: ", e.what());
     return 2;
   } catch (const datasets::DatasetError& e) {  // a frame or file of a dataset that is bad input

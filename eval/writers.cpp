@@ -61,10 +61,29 @@ std::string phase_name(const RunRecord& run, int p) {
                                                             : fmt::format("phase {}", p);
 }
 
+// What the numbers mean, in the file itself, so that a reader (or a baseline) never depends on a
+// convention kept elsewhere.
+json metrics_conventions() {
+  return {
+      {"axes", "every [x, y, z] is along the world frame's axes (right-handed, z up); formation "
+               "components are [lambda_x, lambda_y, lambda_z, psi]"},
+      {"units",
+       {{"mse", "m^2"}, {"final_mse", "m^2"}, {"init_mse", "m^2"}, {"rms_error", "m"},
+        {"max_error", "m"}, {"t", "s"}, {"wall_time_s", "s"}, {"timings_ms", "ms"},
+        {"*_px", "px"}, {"nees", "dimensionless; a consistent filter averages dof"},
+        {"formation", "m for lambda_x, lambda_y, lambda_z; rad for psi"}}},
+      {"histograms", "counts has one entry more than bin_edges_px: counts[0] holds the values "
+                     "below the first edge, counts[i] those in [edge[i-1], edge[i]), the last "
+                     "those at or above the last edge"},
+      {"missing", "null: no value (an empty set of steps, or no NEES at step 0)"}};
+}
+
 }  // namespace
 
 void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& path) {
   json j;
+  j["schema_version"] = kMetricsSchemaVersion;
+  j["conventions"] = metrics_conventions();
   j["software_version"] = run.software_version;
   j["scenario"] = {{"path", run.scenario_path},       {"name", run.scenario_name},
                    {"variant", run.variant},          {"seed", run.seed},

@@ -1,6 +1,6 @@
 // Writes a run's results in formats other tools read (docs/design.md, files): metrics.json, TUM
 // trajectories, per-step and landmark CSVs, the map as PLY, and a fixed-width summary for
-// stdout. NaN is written as JSON null and as "nan" in CSV. All writers throw
+// stdout. NaN is written as JSON null and as an empty CSV field. All writers throw
 // std::runtime_error naming the file if it cannot be written.
 #pragma once
 
@@ -12,7 +12,12 @@
 
 namespace wingman::eval {
 
-// Every table of compute_metrics plus the scenario, phases and software version.
+// metrics.json's layout version: a reader (wingman check) refuses files of another one. Raised
+// whenever a key is renamed, removed or changes meaning; adding a key keeps it.
+inline constexpr int kMetricsSchemaVersion = 2;
+
+// Every table of compute_metrics plus the scenario, phases and software version, headed by
+// schema_version and conventions (units, axis order, histogram bins).
 void write_metrics_json(const Metrics& metrics, const RunRecord& run,
                         const std::filesystem::path& path);
 

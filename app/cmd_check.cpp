@@ -1,0 +1,89 @@
+// `wingman check`: a results or Monte Carlo directory against a baseline (metric regressions,
+// eval/check.hpp), or against another results directory (determinism, eval/same_results.hpp).
+// Exit 0 when nothing fails, 1 when something regressed or differs, 2 for bad input; reports
+// are written only once everything was judged, each atomically.
+#include "app/subcommand.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "eval/atomic_file.hpp"
+#include "eval/check.hpp"
+#include "eval/same_results.hpp"
+
+namespace fs = std::filesystem;
+
+namespace wingman::app {
+namespace {
+
+struct CheckCommand {
+  std::string dir, baseline, against, junit, markdown, json;
+  bool quiet = false;
+};
+
+// The determinism check as a report: one row per data file compared or missing.
+eval::CheckReport against_report(const CheckCommand& o) {
+  const eval::TreeComparison c = eval::compare_results_trees(o.dir, o.against);
+  eval::CheckReport r;
+  r.results = o.dir;
+  r.baseline = o.against;
+  for (const std::string& d : c.differences) {
+    eval::CheckRow row;
+    row.metric = d.substr(0, d.find(": "));
+    row.rule = "identical";
+    row.detail = d.substr(d.find(": ") + 2);
+    row.verdict = eval::Verdict::kFail;
+    r.rows.push_back(row);
+    ++r.failed;
+  }
+  eval::CheckRow all;
+  all.metric = fmt::format("{} data files", c.files_compared);
+  all.rule = "identical";
+  all.detail = c.identical() ? "identical, timings aside" : fmt::format("{} differ", c.differences.size());
+  all.verdict = c.identical() ? eval::Verdict::kPass : eval::Verdict::kFail;
+  r.failed += !c.identical();
+  r.rows.insert(r.rows.begin(), all);
+  return r;
+}
+
+void write_report(const std::string& path, const std::string& text) {
+  if (path.empty()) return;
+  if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
+  eval::write_file_atomic(path, text);
+}
+
+int check_command(const CheckCommand& o) {
+  if (o.baseline.empty() == o.against.empty())
+    throw UsageError("give one of --baseline FILE (metric regressions) or --against DIR (determinism)");
+  const eval::CheckReport r = o.against.empty()
+                                  ? eval::check_against_baseline(eval::read_metric_set(o.dir), eval::read_baseline(o.baseline))
+                                  : against_report(o);
+  write_report(o.junit, eval::check_junit(r));
+  write_report(o.markdown, eval::check_markdown(r));
+  write_report(o.json, eval::check_json(r));
+  if (!o.quiet || r.failed > 0) fmt::print("{}", eval::format_check(r));
+  return r.failed > 0 ? 1 : 0;
+}
+
+}  // namespace
+
+Subcommand add_check(CLI::App& parent) {
+  auto o = std::make_shared<CheckCommand>();
+  auto* cmd = parent.add_subcommand(
+      "check", "Judge a results or Monte Carlo directory against a baseline (exit 1 when a metric regressed), or "
+               "against another results directory of the same scenario and seed (identical, timings aside)");
+  cmd->add_option("results", o->dir, "Results directory (wingman run) or Monte Carlo directory")->required();
+  cmd->add_option("--baseline,-b", o->baseline, "Baseline file (wingman baseline)");
+  cmd->add_option("--against", o->against, "Another results directory that must hold the same results");
+  cmd->add_option("--junit", o->junit, "Also write JUnit XML (one testcase per metric) to this file");
+  cmd->add_option("--markdown", o->markdown, "Also write a Markdown report (a pull-request comment) to this file");
+  cmd->add_option("--json", o->json, "Also write the verdicts as JSON to this file");
+  cmd->add_flag("--quiet,-q", o->quiet, "Print the table only when something failed");
+  return {cmd, [o] { return check_command(*o); }};
+}
+
+}  // namespace wingman::app

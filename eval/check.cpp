@@ -1,0 +1,197 @@
+#include "eval/check.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cmath>
+
+#include "eval/montecarlo.hpp"
+#include "eval/paired.hpp"
+
+namespace wingman::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+// An interval [lo, hi] for "now minus (or over) the reference", judged against a margin on the
+// worse side: the regression must be beyond seed noise and beyond the tolerance. `neutral` is
+// the no-change value (0 for a difference, 1 for a ratio), `up` and `down` the margins' ends.
+Verdict judge_interval(double lo, double hi, double up, double down, Better better) {
+  const bool above = lo > up, below = hi < down;
+  switch (better) {
+    case Better::kLower: return above ? Verdict::kFail : below ? Verdict::kImproved : Verdict::kPass;
+    case Better::kHigher: return below ? Verdict::kFail : above ? Verdict::kImproved : Verdict::kPass;
+    case Better::kEither: return above || below ? Verdict::kFail : Verdict::kPass;
+  }
+  return Verdict::kPass;
+}
+
+std::string signed_num(double v) { return fmt::format("{:+.4g}", v); }
+
+std::string rule_text(const BaselineEntry& e) {
+  const char* side = e.better == Better::kLower ? "+" : e.better == Better::kHigher ? "-" : "+/-";
+  switch (e.rule) {
+    case Rule::kMax: return fmt::format("max {:.4g}", e.limit);
+    case Rule::kMin: return fmt::format("min {:.4g}", e.limit);
+    case Rule::kRel: return fmt::format("rel {}{:.4g}%", side, 100 * e.tolerance);
+    case Rule::kAbs: return fmt::format("abs {}{:.4g}", side, e.tolerance);
+    case Rule::kMean: return fmt::format("mean {}{:.4g}%", side, 100 * e.tolerance);
+    case Rule::kPaired: return fmt::format("paired {}{:.4g}%", side, 100 * e.tolerance);
+  }
+  return "?";
+}
+
+// max, min, rel, abs: the value (the seeds' mean) against a bound or a tolerance.
+void judge_plain(const BaselineEntry& e, CheckRow& row) {
+  const double v = row.now;
+  if (e.rule == Rule::kMax || e.rule == Rule::kMin) {
+    const bool bad = e.rule == Rule::kMax ? v > e.limit : v < e.limit;
+    row.verdict = bad ? Verdict::kFail : Verdict::kPass;
+    row.detail = fmt::format("{:.6g} {} the {} {:.6g}", v, bad ? "breaks" : "keeps", rule_name(e.rule), e.limit);
+    return;
+  }
+  const double allowed = e.rule == Rule::kRel ? e.tolerance * std::abs(e.reference) : e.tolerance;
+  const double d = v - e.reference;
+  row.verdict = judge_interval(d, d, allowed, -allowed, e.better);
+  row.detail = fmt::format("{:.6g} against {:.6g}: {} ({}), allowed {}{:.4g}", v, e.reference, signed_num(d),
+                           std::isfinite(row.change) && row.change_relative ? fmt::format("{:+.1f}%", 100 * row.change) : "-",
+                           e.better == Better::kEither ? "+/-" : e.better == Better::kLower ? "+" : "-", allowed);
+}
+
+struct Sample {
+  double mean = kNaN, var = kNaN;
+  int n = 0;
+};
+Sample sample_of(const std::vector<double>& v) {
+  const Spread s = spread_of(v);
+  return {s.mean, s.n > 1 ? s.std * s.std : kNaN, s.n};
+}
+
+// mean: Welch's 95 % interval of now's mean minus the baseline's; a side with one value borrows
+// the other side's spread (the same filter on other seeds).
+void judge_mean(const BaselineEntry& e, const Sample& now, CheckRow& row, const std::string& where) {
+  Sample ref{e.reference, e.n > 1 ? e.std * e.std : kNaN, e.n};
+  double dof_a = ref.n - 1, dof_b = now.n - 1;
+  if (!std::isfinite(ref.var)) ref.var = now.var, dof_a = dof_b;
+  Sample b = now;
+  if (!std::isfinite(b.var)) b.var = ref.var, dof_b = dof_a;
+  if (!std::isfinite(ref.var) || dof_a < 1)
+    throw CheckInputError(fmt::format("{}: rule mean needs the spread of at least two seeds, in the baseline "
+                                      "(std, n) or in the results; use rel or abs for a single run", where));
+  const double va = ref.var / ref.n, vb = b.var / b.n, se = std::sqrt(va + vb);
+  const double dof = se > 0 ? (va + vb) * (va + vb) / (va * va / dof_a + vb * vb / dof_b) : dof_a + dof_b;
+  const double q = student_t_quantile(0.975, std::max(1.0, dof));
+  const double d = now.mean - ref.mean, lo = d - q * se, hi = d + q * se, margin = e.tolerance * std::abs(ref.mean);
+  row.verdict = judge_interval(lo, hi, margin, -margin, e.better);
+  row.detail = fmt::format("mean of {} seeds {:.6g} against {:.6g} (std {:.4g}, n {}): difference {}, 95% CI "
+                           "[{}, {}] (Welch, {:.1f} dof); a regression when the CI lies beyond {}{:.4g}",
+                           now.n, now.mean, ref.mean, e.std, e.n, signed_num(d), signed_num(lo), signed_num(hi), dof,
+                           e.better == Better::kHigher ? "-" : e.better == Better::kLower ? "+" : "+/-", margin);
+}
+
+// paired: seed by seed on the seeds both sides have.
+void judge_paired(const BaselineEntry& e, const std::vector<double>& values, const std::vector<std::uint64_t>& seeds,
+                  CheckRow& row, const std::string& where) {
+  std::vector<double> a, b;
+  std::vector<std::uint64_t> common;
+  for (std::size_t i = 0; i < seeds.size(); ++i)
+    if (auto it = e.per_seed.find(seeds[i]); it != e.per_seed.end() && std::isfinite(values[i]))
+      a.push_back(it->second), b.push_back(values[i]), common.push_back(seeds[i]);
+  if (a.size() < 2)
+    throw CheckInputError(fmt::format("{}: rule paired needs two seeds that both the baseline's per_seed and the "
+                                      "results have; they share {} (results: seeds {}); use rule mean for other seeds",
+                                      where, a.size(), fmt::join(seeds, ", ")));
+  int worse = 0, better = 0;
+  const bool lower = e.better != Better::kHigher;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (b[i] != a[i]) ++((b[i] > a[i]) == lower ? worse : better);
+  const double p = worse + better > 0 ? sign_test_p(worse, worse + better) : 1.0;
+  const bool positive = std::all_of(a.begin(), a.end(), [](double x) { return x > 0; }) &&
+                        std::all_of(b.begin(), b.end(), [](double x) { return x > 0; });
+  const char* side = e.better == Better::kHigher ? "below" : e.better == Better::kLower ? "above" : "outside";
+  if (positive) {
+    const PairedRow r = compare_values(a, b);
+    const double up = 1 + e.tolerance;
+    row.verdict = judge_interval(r.ratio_lo, r.ratio_hi, up, 1 / up, e.better);
+    row.detail = fmt::format("{} seeds in common: ratio now/baseline {:.4g}, 95% CI [{:.4g}, {:.4g}] (geometric "
+                             "mean); {} on {} of {} seeds that changed (sign test p = {:.3g}); a regression when "
+                             "the CI lies {} [{:.4g}, {:.4g}]", a.size(), r.ratio, r.ratio_lo, r.ratio_hi,
+                             e.better == Better::kEither ? "higher" : "worse", worse, worse + better, p, side, 1 / up, up);
+    return;
+  }
+  std::vector<double> d(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) d[i] = b[i] - a[i];
+  const Spread s = spread_of(d);
+  const double half = student_t_quantile(0.975, s.n - 1) * s.std / std::sqrt(s.n);
+  const double margin = e.tolerance * std::abs(spread_of(a).mean);
+  row.verdict = judge_interval(s.mean - half, s.mean + half, margin, -margin, e.better);
+  row.detail = fmt::format("{} seeds in common: mean difference now - baseline {}, 95% CI [{}, {}]; worse on {} of "
+                           "{} seeds that changed (sign test p = {:.3g}); a regression when the CI lies {} +/-{:.4g}",
+                           a.size(), signed_num(s.mean), signed_num(s.mean - half), signed_num(s.mean + half), worse,
+                           worse + better, p, side, margin);
+}
+
+}  // namespace
+
+const char* verdict_name(Verdict v) {
+  switch (v) {
+    case Verdict::kPass: return "pass";
+    case Verdict::kImproved: return "improved";
+    case Verdict::kWarn: return "WARN";
+    case Verdict::kFail: return "FAIL";
+  }
+  return "?";
+}
+
+CheckRow check_metric(const BaselineEntry& e, const std::vector<double>& values,
+                      const std::vector<std::uint64_t>& seeds, const fs::path& baseline_file) {
+  const std::string where = fmt::format("{}:{}: metric {}", baseline_file.string(), e.line, e.metric);
+  CheckRow row;
+  row.metric = e.metric;
+  row.line = e.line;
+  row.reference = e.reference;
+  row.rule = rule_text(e);
+  const Sample now = sample_of(values);
+  row.now = now.mean;
+  row.change_relative = e.reference != 0;
+  row.change = row.change_relative ? (now.mean - e.reference) / std::abs(e.reference) : now.mean - e.reference;
+  if (now.n == 0) {
+    row.verdict = e.warn_only ? Verdict::kWarn : Verdict::kFail;
+    row.detail = "the results have no value for it (null: an empty set of steps, or a filter that broke down)";
+    return row;
+  }
+  if (e.rule == Rule::kMean) judge_mean(e, now, row, where);
+  else if (e.rule == Rule::kPaired) judge_paired(e, values, seeds, row, where);
+  else judge_plain(e, row);
+  if (row.verdict == Verdict::kFail && e.warn_only) row.verdict = Verdict::kWarn;
+  return row;
+}
+
+CheckReport check_against_baseline(const MetricSet& results, const Baseline& baseline) {
+  for (const BaselineEntry& e : baseline.entries)
+    if (!results.has(e.metric))
+      throw CheckInputError(fmt::format("{}:{}: metric {}: {} has no such metric{}", baseline.file.string(), e.line,
+                                        e.metric, results.dir.string(),
+                                        results.monte_carlo == (baseline.kind == "montecarlo") ? ""
+                                            : fmt::format(" (the baseline is of a {} directory)", baseline.kind)));
+  CheckReport r;
+  r.results = results.dir;
+  r.baseline = baseline.file;
+  for (const BaselineEntry& e : baseline.entries)
+    r.rows.push_back(check_metric(e, results.values.at(e.metric), results.seeds, baseline.file));
+  for (const std::string& failure : results.numerical_failures) {
+    CheckRow row;
+    row.metric = "numerical_failure";
+    row.rule = "none allowed";
+    row.detail = failure;
+    row.verdict = Verdict::kFail;
+    r.rows.push_back(row);
+  }
+  for (const CheckRow& row : r.rows) {
+    r.failed += row.verdict == Verdict::kFail;
+    r.warned += row.verdict == Verdict::kWarn;
+  }
+  return r;
+}
+
+}  // namespace wingman::eval

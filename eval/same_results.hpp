@@ -1,0 +1,32 @@
+// The determinism check (`wingman check A --against B`): two results trees of the same scenario
+// and seed (results directories, their variants, Monte Carlo directories) must hold the same
+// data, timings aside. Every data file under either tree is compared with its namesake:
+//   CSV         row by row and column by column, the timing columns (t_*_ms) left out, an
+//               empty field and "nan" both meaning no value;
+//   JSON        key by key, without wall times, timings (keys ending _ms, timings_ms,
+//               *_ms_per_step), the software version and the scenario file's path;
+//   YAML, TUM, PLY, TXT   line by line, comment lines (#) of YAML left out (they name paths).
+// Plots, videos, logs and images are not compared (they carry timings or encoder state).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace wingman::eval {
+
+struct TreeComparison {
+  int files_compared = 0;
+  // One line per file that differs or is only in one tree: "<relative path>: <first difference>".
+  std::vector<std::string> differences;
+  bool identical() const { return differences.empty(); }
+};
+
+// Throws CheckInputError (eval/metric_set.hpp) when either is not a directory holding results.
+TreeComparison compare_results_trees(const std::filesystem::path& a, const std::filesystem::path& b);
+
+// The first difference of two files of the same kind ("" when the same), named by row and
+// column or key path.
+std::string first_difference(const std::filesystem::path& a, const std::filesystem::path& b);
+
+}  // namespace wingman::eval
