@@ -112,11 +112,14 @@ void judge_paired(const BaselineEntry& e, const std::vector<double>& values, con
   if (positive) {
     const PairedRow r = compare_values(a, b);
     const double up = 1 + e.tolerance;
+    const std::string limit = e.better == Better::kHigher ? fmt::format("below {:.4g}", 1 / up)
+                              : e.better == Better::kLower ? fmt::format("above {:.4g}", up)
+                                                           : fmt::format("outside [{:.4g}, {:.4g}]", 1 / up, up);
     row.verdict = judge_interval(r.ratio_lo, r.ratio_hi, up, 1 / up, e.better);
     row.detail = fmt::format("{} seeds in common: ratio now/baseline {:.4g}, 95% CI [{:.4g}, {:.4g}] (geometric "
                              "mean); {} on {} of {} seeds that changed (sign test p = {:.3g}); a regression when "
-                             "the CI lies {} [{:.4g}, {:.4g}]", a.size(), r.ratio, r.ratio_lo, r.ratio_hi,
-                             e.better == Better::kEither ? "higher" : "worse", worse, worse + better, p, side, 1 / up, up);
+                             "the CI lies {}", a.size(), r.ratio, r.ratio_lo, r.ratio_hi,
+                             e.better == Better::kEither ? "higher" : "worse", worse, worse + better, p, limit);
     return;
   }
   std::vector<double> d(a.size());
@@ -168,6 +171,9 @@ CheckRow check_metric(const BaselineEntry& e, const std::vector<double>& values,
 }
 
 CheckReport check_against_baseline(const MetricSet& results, const Baseline& baseline) {
+  if (!baseline.scenario.empty() && !results.scenario.empty() && baseline.scenario != results.scenario)
+    throw CheckInputError(fmt::format("{}: a baseline of scenario '{}', but {} holds scenario '{}'",
+                                      baseline.file.string(), baseline.scenario, results.dir.string(), results.scenario));
   for (const BaselineEntry& e : baseline.entries)
     if (!results.has(e.metric))
       throw CheckInputError(fmt::format("{}:{}: metric {}: {} has no such metric{}", baseline.file.string(), e.line,

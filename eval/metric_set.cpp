@@ -19,7 +19,7 @@ using nlohmann::json;
 
 // Keys that are not metrics: identity, conventions, per-step series and indices.
 const std::set<std::string> kSkippedKeys = {
-    "schema_version", "conventions", "software_version", "scenario", "agents", "numerical_failure",
+    "schema_version", "conventions", "software_version", "scenario", "numerical_failure",
     "per_step", "count_per_step", "phase", "per_agent", "per_phase_mean", "accepted_error_histogram",
     "t_start", "t_end", "t_from", "config", "components"};
 
