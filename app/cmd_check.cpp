@@ -25,29 +25,28 @@ struct CheckCommand {
   bool quiet = false;
 };
 
-// The determinism check as a report: one row per data file compared or missing.
-eval::CheckReport against_report(const CheckCommand& o) {
-  const eval::TreeComparison c = eval::compare_results_trees(o.dir, o.against);
+// The determinism check as a report: one row per data file.
+eval::CheckReport against_report(const eval::TreeComparison& c, const CheckCommand& o) {
   eval::CheckReport r;
   r.results = o.dir;
   r.baseline = o.against;
-  for (const std::string& d : c.differences) {
+  for (const auto& f : c.files) {
     eval::CheckRow row;
-    row.metric = d.substr(0, d.find(": "));
+    row.metric = f.path;
     row.rule = "identical";
-    row.detail = d.substr(d.find(": ") + 2);
-    row.verdict = eval::Verdict::kFail;
+    row.detail = f.difference.empty() ? "identical, timings aside" : f.difference;
+    row.verdict = f.difference.empty() ? eval::Verdict::kPass : eval::Verdict::kFail;
+    r.failed += !f.difference.empty();
     r.rows.push_back(row);
-    ++r.failed;
   }
-  eval::CheckRow all;
-  all.metric = fmt::format("{} data files", c.files_compared);
-  all.rule = "identical";
-  all.detail = c.identical() ? "identical, timings aside" : fmt::format("{} differ", c.differences.size());
-  all.verdict = c.identical() ? eval::Verdict::kPass : eval::Verdict::kFail;
-  r.failed += !c.identical();
-  r.rows.insert(r.rows.begin(), all);
   return r;
+}
+
+void print_against(const eval::TreeComparison& c, const CheckCommand& o) {
+  for (const auto& f : c.files)
+    if (!f.difference.empty()) fmt::print("{}: {}\n", f.path, f.difference);
+  if (c.identical()) fmt::print("{} and {}: identical, timings aside ({} data files)\n", o.dir, o.against, c.files.size());
+  else fmt::print("{} and {}: {} of {} data files differ\n", o.dir, o.against, c.differing(), c.files.size());
 }
 
 void write_report(const std::string& path, const std::string& text) {
@@ -59,13 +58,18 @@ void write_report(const std::string& path, const std::string& text) {
 int check_command(const CheckCommand& o) {
   if (o.baseline.empty() == o.against.empty())
     throw UsageError("give one of --baseline FILE (metric regressions) or --against DIR (determinism)");
-  const eval::CheckReport r = o.against.empty()
-                                  ? eval::check_against_baseline(eval::read_metric_set(o.dir), eval::read_baseline(o.baseline))
-                                  : against_report(o);
+  eval::CheckReport r;
+  if (o.against.empty()) {
+    r = eval::check_against_baseline(eval::read_metric_set(o.dir), eval::read_baseline(o.baseline));
+  } else {
+    const eval::TreeComparison c = eval::compare_results_trees(o.dir, o.against);
+    r = against_report(c, o);
+    if (!o.quiet || !c.identical()) print_against(c, o);
+  }
   write_report(o.junit, eval::check_junit(r));
   write_report(o.markdown, eval::check_markdown(r));
   write_report(o.json, eval::check_json(r));
-  if (!o.quiet || r.failed > 0) fmt::print("{}", eval::format_check(r));
+  if (o.against.empty() && (!o.quiet || r.failed > 0)) fmt::print("{}", eval::format_check(r));
   return r.failed > 0 ? 1 : 0;
 }
 

@@ -26,14 +26,22 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
+// Errors of an estimate against the truth: lower is better.
+bool is_error_metric(const std::string& m) {
+  for (const char* part : {".mse.", "final_mse.", "init_mse.", "rms_error", "max_error", "_px.", ".rms.", ".max_abs.",
+                           "settling_time"})
+    if (m.find(part) != std::string::npos) return true;
+  return false;
+}
+
 // Fractions and rates have an absolute tolerance (a relative one around 0 means nothing);
-// timings warn (machines differ); the NEES is wrong on either side; errors are lower-is-better.
+// timings warn (machines differ); errors are lower-is-better; anything else (the NEES, counts)
+// is wrong on either side.
 Default default_rule(const std::string& metric, bool monte_carlo) {
   if (is_timing_metric(metric)) return {monte_carlo ? Rule::kMean : Rule::kRel, 1.0, Better::kLower, true};
   if (ends_with(metric, "_fraction")) return {Rule::kAbs, 0.02, Better::kLower, false};
   if (ends_with(metric, "_rate")) return {Rule::kAbs, 0.05, Better::kHigher, false};
-  const bool nees = metric.find("nees.") != std::string::npos;
-  const Better better = nees ? Better::kEither : Better::kLower;
+  const Better better = is_error_metric(metric) ? Better::kLower : Better::kEither;
   return monte_carlo ? Default{Rule::kPaired, 0.10, better, false} : Default{Rule::kRel, 0.25, better, false};
 }
 

@@ -192,9 +192,11 @@ std::vector<std::string> select_metrics(const MetricSet& set, const std::vector<
                                         set.dir.string(), fmt::join(some, ", ")));
     }
   }
-  for (const auto& p : set.paths)
-    if (std::any_of(globs.begin(), globs.end(), [&](const auto& g) { return fnmatch(g.c_str(), p.c_str(), 0) == 0; }))
-      chosen.push_back(p);
+  // In the order of the globs, each metric once.
+  std::set<std::string> seen;
+  for (const auto& g : globs)
+    for (const auto& p : set.paths)
+      if (fnmatch(g.c_str(), p.c_str(), 0) == 0 && seen.insert(p).second) chosen.push_back(p);
   return chosen;
 }
 

@@ -54,7 +54,7 @@ bool is_timing_metric(const std::string& path);
 std::vector<std::string> default_metrics(const MetricSet& set);
 
 // The metrics of set matching any of the shell globs (fnmatch, '*' crosses '.' and '/'), in
-// set order. CheckInputError naming a glob that matches nothing.
+// the order of the globs. CheckInputError naming a glob that matches nothing.
 std::vector<std::string> select_metrics(const MetricSet& set, const std::vector<std::string>& globs);
 
 }  // namespace wingman::eval

@@ -120,23 +120,23 @@ std::string first_difference(const fs::path& a, const fs::path& b) {
   return text_difference(a, b, ext == ".yaml");
 }
 
+int TreeComparison::differing() const {
+  return static_cast<int>(std::count_if(files.begin(), files.end(), [](const File& f) { return !f.difference.empty(); }));
+}
+
 TreeComparison compare_results_trees(const fs::path& a, const fs::path& b) {
   for (const auto& d : {a, b})
     if (!fs::is_directory(d)) throw CheckInputError(fmt::format("{}: no such directory", d.string()));
   const auto fa = data_files(a), fb = data_files(b);
   if (std::none_of(fa.begin(), fa.end(), [](const auto& f) { return f.ends_with("metrics.json"); }))
     throw CheckInputError(fmt::format("{}: holds no results (no metrics.json)", a.string()));
+  std::set<std::string> all = fa;
+  all.insert(fb.begin(), fb.end());
   TreeComparison c;
-  for (const auto& f : fa) {
-    if (!fb.count(f)) {
-      c.differences.push_back(fmt::format("{}: only in {}", f, a.string()));
-      continue;
-    }
-    ++c.files_compared;
-    if (auto d = first_difference(a / f, b / f); !d.empty()) c.differences.push_back(fmt::format("{}: {}", f, d));
+  for (const auto& f : all) {
+    if (!fa.count(f) || !fb.count(f)) c.files.push_back({f, fmt::format("only in {}", (fa.count(f) ? a : b).string())});
+    else c.files.push_back({f, first_difference(a / f, b / f)});
   }
-  for (const auto& f : fb)
-    if (!fa.count(f)) c.differences.push_back(fmt::format("{}: only in {}", f, b.string()));
   return c;
 }
 

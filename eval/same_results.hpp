@@ -16,10 +16,13 @@
 namespace wingman::eval {
 
 struct TreeComparison {
-  int files_compared = 0;
-  // One line per file that differs or is only in one tree: "<relative path>: <first difference>".
-  std::vector<std::string> differences;
-  bool identical() const { return differences.empty(); }
+  struct File {
+    std::string path;        // relative to the trees
+    std::string difference;  // the first one ("only in <tree>" for a file one tree lacks); "" when the same
+  };
+  std::vector<File> files;  // every data file of either tree, sorted
+  int differing() const;
+  bool identical() const { return differing() == 0; }
 };
 
 // Throws CheckInputError (eval/metric_set.hpp) when either is not a directory holding results.

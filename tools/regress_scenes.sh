@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every shipped scene (or those named) with one wingman binary, seed 1, every variant:
-# synthetic scenes whole, rendered ones over their first 20 s. Compare two such trees with
-# tools/compare_results.py to show that a change leaves results unchanged.
+# synthetic scenes whole, rendered ones over their first 20 s. Compare two such trees, made
+# before and after a change, with `wingman check A --against B` (every data file, timings
+# aside; docs/check.md) to show that the change leaves results unchanged.
 #   tools/regress_scenes.sh WINGMAN OUTDIR [scenes/X.yaml ...]
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
