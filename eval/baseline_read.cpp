@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "eval/baseline.hpp"
@@ -39,6 +40,16 @@ class Reader {
     return n.Scalar();
   }
 
+  // yaml-cpp keeps one of two equal keys silently; a baseline must not.
+  void unique_keys(const YAML::Node& map, const std::string& where) const {
+    std::map<std::string, int> seen;
+    for (const auto& kv : map) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "";
+      if (auto [it, added] = seen.emplace(key, kv.first.Mark().line + 1); !added)
+        fail(kv.first, fmt::format("{}duplicate key '{}' (first at line {})", where, key, it->second));
+    }
+  }
+
   BaselineEntry entry(const YAML::Node& m, std::size_t index) const;
   void header(const YAML::Node& root, Baseline& b) const;
 
@@ -65,6 +76,7 @@ BaselineEntry Reader::entry(const YAML::Node& m, std::size_t index) const {
   e.metric = m["metric"].Scalar();
   e.line = m.Mark().line + 1;
   const std::string where = fmt::format("metric {}: ", e.metric);
+  unique_keys(m, where);
   for (const auto& kv : m)
     if (!keys.count(kv.first.Scalar()))
       fail(kv.first, fmt::format("{}unknown key '{}' (known: metric, reference, rule, tolerance, limit, better, "
@@ -103,6 +115,7 @@ BaselineEntry Reader::entry(const YAML::Node& m, std::size_t index) const {
 
 void Reader::header(const YAML::Node& root, Baseline& b) const {
   if (!root.IsMap()) fail(root, "a baseline is a mapping with baseline_schema, metrics_schema and metrics");
+  unique_keys(root, "");
   for (const char* k : {"baseline_schema", "metrics_schema", "metrics"})
     if (!root[k]) fail(root, fmt::format("'{}' is missing", k));
   if (number(root["baseline_schema"], "baseline_schema", "") != kBaselineSchemaVersion)
@@ -113,7 +126,16 @@ void Reader::header(const YAML::Node& root, Baseline& b) const {
     fail(root["metrics_schema"], fmt::format("made from metrics schema {}, this wingman writes schema {}: "
                                              "make the baseline again (wingman baseline)", b.metrics_schema,
                                              kMetricsSchemaVersion));
+  for (const auto& kv : root)
+    if (!std::set<std::string>{"baseline_schema", "metrics_schema", "source", "metrics"}.count(kv.first.Scalar()))
+      fail(kv.first, fmt::format("unknown key '{}' (known: baseline_schema, metrics_schema, source, metrics)",
+                                 kv.first.Scalar()));
   if (const YAML::Node src = root["source"]; src && src.IsMap()) {
+    unique_keys(src, "source: ");
+    for (const auto& kv : src)
+      if (!std::set<std::string>{"kind", "scenario", "software_version", "seeds"}.count(kv.first.Scalar()))
+        fail(kv.first, fmt::format("source: unknown key '{}' (known: kind, scenario, software_version, seeds)",
+                                   kv.first.Scalar()));
     if (src["kind"]) b.kind = word(src["kind"], "kind", "source: ", {"results", "montecarlo"});
     if (src["scenario"] && src["scenario"].IsScalar()) b.scenario = src["scenario"].Scalar();
     if (src["software_version"] && src["software_version"].IsScalar()) b.software_version = src["software_version"].Scalar();

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Seeded mutation fuzzer for wingman's two input readers.
+"""Seeded mutation fuzzer for wingman's input readers: scenarios, datasets and baselines.
 
     tools/fuzz_inputs.py --wingman build/app/wingman --workdir DIR
-        [--scenario-mutants N] [--dataset-corruptions M] [--seed S] [--time-budget SECONDS]
-        [--jobs J] [--timeout T] [--mem-gib G] [--dataset DS]
+        [--scenario-mutants N] [--dataset-corruptions M] [--baseline-mutants K] [--seed S]
+        [--time-budget SECONDS] [--jobs J] [--timeout T] [--mem-gib G] [--dataset DS]
 
 Scenario mutants: a shipped scene (scenes/*.yaml) with 1 to 3 mutations (an extreme or odd
 value, a deleted, duplicated or unknown key, a truncated file, random bytes, a changed indent,
@@ -12,10 +12,15 @@ two swapped lines), each run as `wingman run MUTANT --out OUT --no-plots -q --du
 (`wingman render scenes/rendered_smoke.yaml --frames 4`, made once in DIR unless --dataset names
 one) with one thing damaged (a PNG frame, a CSV line, an agent folder, dataset.yaml, a
 sensor.yaml, the scenario.yaml), each run as `wingman slam COPY --out OUT --no-plots -q`.
+Baseline mutants: baselines/smoke.yaml with 1 to 3 of the scenario mutations, each run as
+`wingman check RESULTS --baseline MUTANT --junit OUT/junit.xml` on a smoke run made once in DIR;
+there exit 0 or 1 (a verdict) with the report written is a clean run, and exit 2 must name the
+mutant and leave no report.
 
 Every run gets a timeout and an address-space cap, and a verdict:
   ok_ran              exit 0, outputs present and no non-finite value but those clean runs
-                      have by design (an undefined metric, see output_nonfinite)
+                      have by design (an undefined metric, see output_nonfinite); for a
+                      baseline mutant, exit 0 or 1 with its report written
   ok_refused          exit 2 and stderr names the input (the mutant or the dataset copy)
   ok_refused_unnamed  exit 2 but stderr names no input file            (finding)
   exit1_bad_input     exit 1, an internal error instead of a refusal   (finding)
@@ -638,7 +643,7 @@ def output_nonfinite(out_dir: Path) -> set:
 @dataclasses.dataclass
 class Case:
     index: int
-    kind: str        # scenario | dataset | baseline
+    kind: str        # scenario | dataset | check (a baseline mutant) | baseline (unmutated)
     seed: int
     argv: list = dataclasses.field(default_factory=list)
     input_path: Path = None
@@ -691,8 +696,27 @@ def leftovers(out_dir: Path, failed: bool) -> list:
     return sorted(found)
 
 
+def check_verdict(res: dict, err: str, case: Case, out_dir: Path) -> str:
+    """`wingman check` on a baseline mutant: 0 and 1 are verdicts, with the report written; a
+    refusal names the mutant and writes no report."""
+    report = (out_dir / "junit.xml").exists()
+    if res["timed_out"]:
+        return "hang"
+    if res["signal"]:
+        return "signal"
+    if res["exit"] in (0, 1):
+        return "ok_ran" if report else "no_output"
+    if res["exit"] != 2:
+        return "exit_other"
+    if report:
+        return "leftover"
+    return "ok_refused" if str(case.input_path) in err else "ok_refused_unnamed"
+
+
 def verdict(res: dict, err: str, case: Case, out_dir: Path, allowed: set) -> str:
     """The first that applies, from the run's fate to its outputs."""
+    if case.kind == "check":
+        return check_verdict(res, err, case, out_dir)
     failed = res["exit"] not in (0, 2)
     if res["timed_out"]:
         return "hang"
@@ -723,11 +747,15 @@ def run_case(case: Case, work: Path, opts, allowed: set) -> dict:
     shutil.rmtree(run_dir, ignore_errors=True)
     run_dir.mkdir(parents=True)
     out_dir = run_dir / "out"  # does not exist before the run
-    argv = [str(a) for a in case.argv] + ["--out", str(out_dir)]
+    if case.kind == "check":  # check writes reports, not a results directory
+        out_dir.mkdir()
+        argv = [str(a) for a in case.argv] + ["--junit", str(out_dir / "junit.xml")]
+    else:
+        argv = [str(a) for a in case.argv] + ["--out", str(out_dir)]
     err_path = work / "stderr" / f"{case.index:04d}.txt"
     res = execute(argv, err_path, opts.timeout, int(opts.mem_gib * 2**30))
     err = keep_short(err_path)
-    res["leftover"] = leftovers(out_dir, res["exit"] != 0)
+    res["leftover"] = [] if case.kind == "check" else leftovers(out_dir, res["exit"] != 0)
     res.update(kind=case.kind, index=case.index, seed=case.seed, mutation=case.description,
                source=case.source, argv=argv)
     res["verdict"] = verdict(res, err, case, out_dir, allowed)
@@ -776,6 +804,30 @@ def dataset_cases(opts, work: Path, dataset: Path, first: int) -> list:
         cases.append(Case(i, "dataset", seed, argv, copy, "", "dataset",
                           lambda seed=seed, copy=copy: corrupt_copy(seed, dataset, copy)))
     return cases
+
+
+def check_cases(opts, work: Path, results: Path, first: int) -> list:
+    """Mutants of the committed smoke baseline (mutants/check-NNNN.yaml), judged against a smoke run."""
+    cases = []
+    corpus = [REPO / "baselines" / "smoke.yaml"]
+    for j in range(opts.baseline_mutants):
+        i, seed = first + j, opts.seed * 1_000_000 + 700_000 + j
+        _, data, desc = scenario_mutant(seed, corpus)
+        path = work / "mutants" / f"check-{i:04d}.yaml"
+        path.write_bytes(data)
+        argv = [opts.wingman, "check", results, "--baseline", path]
+        cases.append(Case(i, "check", seed, argv, path, f"smoke baseline: {desc}", "baselines/smoke.yaml"))
+    return cases
+
+
+def make_smoke_results(opts, work: Path) -> Path:
+    """The smoke run the baseline mutants are checked against, made once per work directory."""
+    res = work / "smoke_results"
+    if not (res / "multi" / "metrics.json").exists():
+        shutil.rmtree(res, ignore_errors=True)
+        subprocess.run([opts.wingman, "run", str(REPO / "scenes" / "smoke.yaml"), "--out", str(res),
+                        "--no-plots", "-q"], check=True, timeout=600)
+    return res
 
 
 def corrupt_copy(seed: int, dataset: Path, copy: Path) -> str:
@@ -881,6 +933,7 @@ def parse_args(argv=None):
     ap.add_argument("--workdir", required=True, help="mutants, outcomes and kept stderr go here")
     ap.add_argument("--scenario-mutants", type=int, default=50)
     ap.add_argument("--dataset-corruptions", type=int, default=20)
+    ap.add_argument("--baseline-mutants", type=int, default=0)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--time-budget", type=float, default=math.inf,
                     help="seconds after which no new run starts")
@@ -908,6 +961,12 @@ def main(argv=None) -> int:
         return 2
     if dataset is not None:
         cases += dataset_cases(opts, work, dataset, len(cases))
+    if opts.baseline_mutants > 0:
+        try:
+            cases += check_cases(opts, work, make_smoke_results(opts, work), len(cases))
+        except (subprocess.SubprocessError, OSError) as e:
+            print(f"error: cannot make the smoke results to check against: {e}", file=sys.stderr)
+            return 2
     runner = Runner(opts, work, start + opts.time_budget)
     base = runner.all(baseline_cases(opts, dataset, len(cases)), set())
     allowed = set().union(*(r.get("nonfinite", []) for r in base))

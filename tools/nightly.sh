@@ -13,4 +13,4 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # ASan reserves a large virtual address space: the fuzzer's memory cap must leave room for it.
 python3 "$here/tools/fuzz_inputs.py" --wingman "$build/app/wingman" --workdir "$work/fuzz" \
-  --scenario-mutants 2000 --dataset-corruptions 300 --jobs "$(nproc)" --mem-gib 0 --timeout 300
+  --scenario-mutants 2000 --dataset-corruptions 300 --baseline-mutants 1000 --jobs "$(nproc)" --mem-gib 0 --timeout 300

@@ -148,6 +148,8 @@ TEST(Baseline, MalformedBaselinesAreRefusedWithFileLineAndKey) {
       {"    tolerance: 0.25\n", "    tolerance: 0.25\n  - metric: nees.mean\n    reference: 1\n    rule: abs\n    tolerance: 1\n",
        "listed twice"},
       {"rule: rel", "rule: [rel", "not valid YAML"},
+      {"rule: rel", "rule: rel\n    rule: abs", "duplicate key 'rule' (first at line 6)"},
+      {"metrics:\n", "metrix: 1\nmetrics:\n", "unknown key 'metrix'"},
   };
   for (const auto& c : cases) {
     std::string text = good;
