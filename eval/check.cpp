@@ -185,9 +185,9 @@ CheckReport check_against_baseline(const MetricSet& results, const Baseline& bas
   r.baseline = baseline.file;
   for (const BaselineEntry& e : baseline.entries)
     r.rows.push_back(check_metric(e, results.values.at(e.metric), results.seeds, baseline.file));
-  for (const std::string& failure : results.numerical_failures) {
+  for (const std::string& failure : results.failures) {
     CheckRow row;
-    row.metric = "numerical_failure";
+    row.metric = "failed_run";
     row.rule = "none allowed";
     row.detail = failure;
     row.verdict = Verdict::kFail;

@@ -50,8 +50,9 @@ CheckRow check_metric(const BaselineEntry& e, const std::vector<double>& values,
                       const std::vector<std::uint64_t>& seeds, const std::filesystem::path& baseline_file);
 
 // Every entry of the baseline. CheckInputError, before judging anything, when the results lack
-// a metric the baseline names or are of another kind than a statistical rule needs. A recorded
-// numerical failure of a run is one more failing row.
+// a metric the baseline names or are of another kind than a statistical rule needs. A failed run
+// (a recorded numerical failure, a Monte Carlo seed montecarlo.json lists as failed) is one more
+// failing row, `failed_run`.
 CheckReport check_against_baseline(const MetricSet& results, const Baseline& baseline);
 
 // The table printed on stdout: metric, baseline, now, change, rule, verdict, then the details

@@ -89,7 +89,7 @@ void add_run(MetricSet& set, const fs::path& file, const std::string& prefix, st
   if (set.scenario.empty() && j.contains("scenario") && j["scenario"].contains("name"))
     set.scenario = j["scenario"]["name"].get<std::string>();
   if (j.contains("numerical_failure") && j["numerical_failure"].is_object())
-    set.numerical_failures.push_back(
+    set.failures.push_back(
         fmt::format("{}: {}", file.string(), j["numerical_failure"].value("message", "numerical failure")));
   Flat flat;
   flatten(j, "", "", flat);
@@ -134,6 +134,10 @@ void read_monte_carlo_dir(MetricSet& set) {
   if (!mc.is_object() || !mc.contains("seeds") || !mc["seeds"].is_array() || mc["seeds"].empty())
     throw CheckInputError(fmt::format("{}: no 'seeds' (written by an older wingman montecarlo?)", file.string()));
   for (const json& s : mc["seeds"]) set.seeds.push_back(s.get<std::uint64_t>());
+  if (mc.contains("failed_seeds") && mc["failed_seeds"].is_array())
+    for (const json& f : mc["failed_seeds"])
+      set.failures.push_back(fmt::format("{}: seed {}: {}", file.string(), f.value("seed", std::uint64_t{0}),
+                                         f.value("reason", std::string("failed"))));
   set.monte_carlo = true;
   const auto run = [&](std::uint64_t seed) { return set.dir / "runs" / fmt::format("seed{}", seed); };
   if (!fs::is_directory(run(set.seeds.front())))

@@ -33,8 +33,9 @@ struct MetricSet {
   std::vector<std::string> paths;      // every metric, in file order
   // Per metric, one value per seed (NaN where the file has null); every path is in paths.
   std::map<std::string, std::vector<double>> values;
-  // Runs whose filter broke down (metrics.json numerical_failure): "<file>: <message>".
-  std::vector<std::string> numerical_failures;
+  // Runs that failed: a recorded numerical failure ("<metrics.json>: <message>") or a Monte
+  // Carlo seed montecarlo.json lists as failed ("<montecarlo.json>: seed N: <reason>").
+  std::vector<std::string> failures;
 
   bool has(const std::string& path) const { return values.count(path) > 0; }
 };

@@ -240,3 +240,34 @@ TEST(SameResults, TheFirstDifferingFieldIsNamed) {
 
 }  // namespace
 }  // namespace wingman::eval
+
+namespace wingman::eval {
+namespace {
+
+TEST(MetricSet, MonteCarloDirectoryGivesOneValuePerSeedAndItsFailedSeedsFail) {
+  test::TempDir tmp;
+  const fs::path mc = tmp.path() / "mc";
+  for (const char* seed : {"seed1", "seed2"}) write_run(mc / "runs" / seed);
+  put(mc / "montecarlo.json",
+      R"({"scenario": "x.yaml", "seeds": [1, 2], "failed_seeds": [{"seed": 3, "reason": "exit 1"}], "variants": []})");
+  const MetricSet set = read_metric_set(mc);
+  EXPECT_TRUE(set.monte_carlo);
+  EXPECT_EQ(set.seeds, (std::vector<std::uint64_t>{1, 2}));
+  EXPECT_EQ(set.values.at("table4.total.lead.mse.x"), (std::vector<double>{0.25, 0.25}));
+  ASSERT_EQ(set.failures.size(), 1u);
+  EXPECT_NE(set.failures[0].find("seed 3: exit 1"), std::string::npos) << set.failures[0];
+
+  const Baseline b = make_baseline(set, {{"table4.total.lead.mse.x"}, -1, -1});
+  ASSERT_EQ(b.entries.size(), 1u);
+  EXPECT_EQ(b.entries[0].rule, Rule::kPaired);
+  EXPECT_EQ(b.entries[0].per_seed.size(), 2u);
+  const CheckReport r = check_against_baseline(set, b);
+  ASSERT_EQ(r.rows.size(), 2u);
+  EXPECT_EQ(r.rows[0].verdict, Verdict::kPass);
+  EXPECT_EQ(r.rows[1].metric, "failed_run");
+  EXPECT_EQ(r.rows[1].verdict, Verdict::kFail);
+  EXPECT_EQ(r.failed, 1);
+}
+
+}  // namespace
+}  // namespace wingman::eval
