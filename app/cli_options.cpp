@@ -8,7 +8,8 @@
 namespace wingman::app {
 
 void add_variant_option(CLI::App* cmd, std::vector<std::string>& variants, const std::string& help) {
-  cmd->add_option("--variant", variants, help + " (repeatable: each in turn)");
+  // One name per --variant, so that a positional argument after it stays positional.
+  cmd->add_option("--variant", variants, help + " (repeatable: each in turn)")->allow_extra_args(false);
 }
 
 int for_each_variant(const std::vector<std::string>& variants, const std::function<int(const std::string&)>& one) {

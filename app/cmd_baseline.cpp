@@ -51,7 +51,8 @@ Subcommand add_baseline(CLI::App& parent) {
   cmd->add_option("--out,-o", o->out, "Baseline file to write (YAML)")->required();
   cmd->add_option("--metrics", o->options.metrics,
                   "Metric paths or shell globs to hold (repeatable; default: Table 4 and 5 totals, accepted-outlier "
-                  "fractions, NEES mean, lead detection, wall time and stage timings)");
+                  "fractions, NEES mean, lead detection, wall time and stage timings)")
+      ->allow_extra_args(false);
   cmd->add_option("--rel", o->options.rel, "Tolerance of the relative rules (rel, mean, paired), a fraction")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--abs", o->options.abs, "Tolerance of the absolute rules (fractions and rates)")

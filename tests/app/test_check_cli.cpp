@@ -158,6 +158,21 @@ TEST(CheckCli, BaselineNeverReplacesAnExistingFileWithoutForce) {
   EXPECT_NE(read_file(tmp / "mine.yaml").find("metric: \"single/nees.mean\""), std::string::npos);
 }
 
+TEST(CheckCli, EachMetricsOptionTakesOneGlobAndKeepsItsOrder) {
+  TempDir tmp;
+  const fs::path good = run_smoke(tmp, "good");
+  // A glob before the positional argument leaves it positional.
+  const RunResult r = run_wingman({"baseline", "--metrics", "single/nees.mean", good.string(), "--metrics",
+                                   "multi/table4.total.lead.mse.x", "--out", (tmp / "b.yaml").string()},
+                                  tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string yaml = read_file(tmp / "b.yaml");
+  EXPECT_LT(yaml.find("single/nees.mean"), yaml.find("multi/table4.total.lead.mse.x"));
+  int entries = 0;
+  for (const auto& line : lines_of(yaml)) entries += line.rfind("  - metric:", 0) == 0;
+  EXPECT_EQ(entries, 2) << yaml;
+}
+
 TEST(CheckCli, MonteCarloBaselineIsJudgedSeedBySeed) {
   TempDir tmp;
   const auto mc = [&](const std::string& name, const fs::path& scenario) {
