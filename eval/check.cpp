@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "eval/montecarlo.hpp"
@@ -13,9 +14,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// An interval [lo, hi] for "now minus (or over) the reference", judged against a margin on the
-// worse side: the regression must be beyond seed noise and beyond the tolerance. `neutral` is
-// the no-change value (0 for a difference, 1 for a ratio), `up` and `down` the margins' ends.
+// An interval [lo, hi] for "now minus (or over) the reference", judged against the margins `up`
+// and `down` around no change (0 for a difference, 1 for a ratio): a regression lies wholly
+// beyond the margin on the worse side, so it must exceed both seed noise and the tolerance.
 Verdict judge_interval(double lo, double hi, double up, double down, Better better) {
   const bool above = lo > up, below = hi < down;
   switch (better) {
@@ -28,8 +29,11 @@ Verdict judge_interval(double lo, double hi, double up, double down, Better bett
 
 std::string signed_num(double v) { return fmt::format("{:+.4g}", v); }
 
+// The sign of a worse change: "+" when lower is better, "-" when higher is, "+/-" for either.
+const char* worse_sign(Better b) { return b == Better::kLower ? "+" : b == Better::kHigher ? "-" : "+/-"; }
+
 std::string rule_text(const BaselineEntry& e) {
-  const char* side = e.better == Better::kLower ? "+" : e.better == Better::kHigher ? "-" : "+/-";
+  const char* side = worse_sign(e.better);
   switch (e.rule) {
     case Rule::kMax: return fmt::format("max {:.4g}", e.limit);
     case Rule::kMin: return fmt::format("min {:.4g}", e.limit);
@@ -55,7 +59,7 @@ void judge_plain(const BaselineEntry& e, CheckRow& row) {
   row.verdict = judge_interval(d, d, allowed, -allowed, e.better);
   row.detail = fmt::format("{:.6g} against {:.6g}: {} ({}), allowed {}{:.4g}", v, e.reference, signed_num(d),
                            std::isfinite(row.change) && row.change_relative ? fmt::format("{:+.1f}%", 100 * row.change) : "-",
-                           e.better == Better::kEither ? "+/-" : e.better == Better::kLower ? "+" : "-", allowed);
+                           worse_sign(e.better), allowed);
 }
 
 struct Sample {
@@ -86,52 +90,66 @@ void judge_mean(const BaselineEntry& e, const Sample& now, CheckRow& row, const 
   row.detail = fmt::format("mean of {} seeds {:.6g} against {:.6g} (std {:.4g}, n {}): difference {}, 95% CI "
                            "[{}, {}] (Welch, {:.1f} dof); a regression when the CI lies beyond {}{:.4g}",
                            now.n, now.mean, ref.mean, e.std, e.n, signed_num(d), signed_num(lo), signed_num(hi), dof,
-                           e.better == Better::kHigher ? "-" : e.better == Better::kLower ? "+" : "+/-", margin);
+                           worse_sign(e.better), margin);
+}
+
+// The seeds' values of a paired comparison and the sign test over the seeds that changed.
+struct Pairs {
+  std::vector<double> a, b;  // baseline, now; the same seed at the same index
+  int worse = 0, better = 0;
+  double sign_p = 1.0;
+  std::string counts(Better direction) const {
+    return fmt::format("{} on {} of {} seeds that changed (sign test p = {:.3g})",
+                       direction == Better::kEither ? "higher" : "worse", worse, worse + better, sign_p);
+  }
+};
+
+// paired, all values > 0: the geometric-mean ratio and its interval against 1 + tolerance.
+void judge_ratio(const BaselineEntry& e, const Pairs& p, CheckRow& row) {
+  const PairedRow r = compare_values(p.a, p.b);
+  const double up = 1 + e.tolerance;
+  const std::string limit = e.better == Better::kHigher  ? fmt::format("below {:.4g}", 1 / up)
+                            : e.better == Better::kLower ? fmt::format("above {:.4g}", up)
+                                                         : fmt::format("outside [{:.4g}, {:.4g}]", 1 / up, up);
+  row.verdict = judge_interval(r.ratio_lo, r.ratio_hi, up, 1 / up, e.better);
+  row.detail = fmt::format("{} seeds in common: ratio now/baseline {:.4g}, 95% CI [{:.4g}, {:.4g}] (geometric mean); "
+                           "{}; a regression when the CI lies {}", p.a.size(), r.ratio, r.ratio_lo, r.ratio_hi,
+                           p.counts(e.better), limit);
+}
+
+// paired with a value <= 0 (a ratio means nothing): the mean difference and its t interval.
+void judge_difference(const BaselineEntry& e, const Pairs& p, CheckRow& row) {
+  std::vector<double> d(p.a.size());
+  for (std::size_t i = 0; i < d.size(); ++i) d[i] = p.b[i] - p.a[i];
+  const Spread s = spread_of(d);
+  const double half = student_t_quantile(0.975, s.n - 1) * s.std / std::sqrt(s.n);
+  const double margin = e.tolerance * std::abs(spread_of(p.a).mean);
+  row.verdict = judge_interval(s.mean - half, s.mean + half, margin, -margin, e.better);
+  row.detail = fmt::format("{} seeds in common: mean difference now - baseline {}, 95% CI [{}, {}]; {}; a regression "
+                           "when the CI lies beyond {}{:.4g}", p.a.size(), signed_num(s.mean), signed_num(s.mean - half),
+                           signed_num(s.mean + half), p.counts(e.better), worse_sign(e.better), margin);
 }
 
 // paired: seed by seed on the seeds both sides have.
 void judge_paired(const BaselineEntry& e, const std::vector<double>& values, const std::vector<std::uint64_t>& seeds,
                   CheckRow& row, const std::string& where) {
-  std::vector<double> a, b;
-  std::vector<std::uint64_t> common;
+  Pairs p;
   for (std::size_t i = 0; i < seeds.size(); ++i)
     if (auto it = e.per_seed.find(seeds[i]); it != e.per_seed.end() && std::isfinite(values[i]))
-      a.push_back(it->second), b.push_back(values[i]), common.push_back(seeds[i]);
-  if (a.size() < 2)
+      p.a.push_back(it->second), p.b.push_back(values[i]);
+  if (p.a.size() < 2)
     throw CheckInputError(fmt::format("{}: rule paired needs two seeds that both the baseline's per_seed and the "
                                       "results have; they share {} (results: seeds {}); use rule mean for other seeds",
-                                      where, a.size(), fmt::join(seeds, ", ")));
-  int worse = 0, better = 0;
+                                      where, p.a.size(), fmt::join(seeds, ", ")));
   const bool lower = e.better != Better::kHigher;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (b[i] != a[i]) ++((b[i] > a[i]) == lower ? worse : better);
-  const double p = worse + better > 0 ? sign_test_p(worse, worse + better) : 1.0;
-  const bool positive = std::all_of(a.begin(), a.end(), [](double x) { return x > 0; }) &&
-                        std::all_of(b.begin(), b.end(), [](double x) { return x > 0; });
-  const char* side = e.better == Better::kHigher ? "below" : e.better == Better::kLower ? "above" : "outside";
-  if (positive) {
-    const PairedRow r = compare_values(a, b);
-    const double up = 1 + e.tolerance;
-    const std::string limit = e.better == Better::kHigher ? fmt::format("below {:.4g}", 1 / up)
-                              : e.better == Better::kLower ? fmt::format("above {:.4g}", up)
-                                                           : fmt::format("outside [{:.4g}, {:.4g}]", 1 / up, up);
-    row.verdict = judge_interval(r.ratio_lo, r.ratio_hi, up, 1 / up, e.better);
-    row.detail = fmt::format("{} seeds in common: ratio now/baseline {:.4g}, 95% CI [{:.4g}, {:.4g}] (geometric "
-                             "mean); {} on {} of {} seeds that changed (sign test p = {:.3g}); a regression when "
-                             "the CI lies {}", a.size(), r.ratio, r.ratio_lo, r.ratio_hi,
-                             e.better == Better::kEither ? "higher" : "worse", worse, worse + better, p, limit);
-    return;
-  }
-  std::vector<double> d(a.size());
-  for (std::size_t i = 0; i < a.size(); ++i) d[i] = b[i] - a[i];
-  const Spread s = spread_of(d);
-  const double half = student_t_quantile(0.975, s.n - 1) * s.std / std::sqrt(s.n);
-  const double margin = e.tolerance * std::abs(spread_of(a).mean);
-  row.verdict = judge_interval(s.mean - half, s.mean + half, margin, -margin, e.better);
-  row.detail = fmt::format("{} seeds in common: mean difference now - baseline {}, 95% CI [{}, {}]; worse on {} of "
-                           "{} seeds that changed (sign test p = {:.3g}); a regression when the CI lies {} +/-{:.4g}",
-                           a.size(), signed_num(s.mean), signed_num(s.mean - half), signed_num(s.mean + half), worse,
-                           worse + better, p, side, margin);
+  for (std::size_t i = 0; i < p.a.size(); ++i)
+    if (p.b[i] != p.a[i]) ++((p.b[i] > p.a[i]) == lower ? p.worse : p.better);
+  if (p.worse + p.better > 0) p.sign_p = sign_test_p(p.worse, p.worse + p.better);
+  const auto positive = [](const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double x) { return x > 0; });
+  };
+  if (positive(p.a) && positive(p.b)) judge_ratio(e, p, row);
+  else judge_difference(e, p, row);
 }
 
 }  // namespace

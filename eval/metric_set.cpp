@@ -81,23 +81,28 @@ json read_metrics(const fs::path& file) {
   return j;
 }
 
-// Adds one run's metrics as seed index `s` of `n`.
-void add_run(MetricSet& set, const fs::path& file, const std::string& prefix, std::size_t s, std::size_t n) {
+// Adds one run's metrics as seed index `s` of `n`; returns the run's seed.
+std::uint64_t add_run(MetricSet& set, const fs::path& file, const std::string& prefix, std::size_t s, std::size_t n) {
   const json j = read_metrics(file);
-  if (set.software_version.empty() && j.contains("software_version") && j["software_version"].is_string())
-    set.software_version = j["software_version"].get<std::string>();
-  if (set.scenario.empty() && j.contains("scenario") && j["scenario"].contains("name"))
-    set.scenario = j["scenario"]["name"].get<std::string>();
-  if (j.contains("numerical_failure") && j["numerical_failure"].is_object())
-    set.failures.push_back(
-        fmt::format("{}: {}", file.string(), j["numerical_failure"].value("message", "numerical failure")));
-  Flat flat;
-  flatten(j, "", "", flat);
-  for (const auto& [path, value] : flat) {
-    const std::string full = prefix + path;
-    auto [it, added] = set.values.try_emplace(full, std::vector<double>(n, kNaN));
-    if (added) set.paths.push_back(full);
-    it->second[s] = value;
+  try {
+    if (set.software_version.empty()) set.software_version = j.value("software_version", std::string());
+    const json& scenario = j.at("scenario");
+    if (set.scenario.empty()) set.scenario = scenario.at("name").get<std::string>();
+    if (j.contains("numerical_failure") && j["numerical_failure"].is_object())
+      set.failures.push_back(fmt::format("{}: {}", file.string(),
+                                         j["numerical_failure"].value("message", std::string("numerical failure"))));
+    Flat flat;
+    flatten(j, "", "", flat);
+    for (const auto& [path, value] : flat) {
+      const std::string full = prefix + path;
+      auto [it, added] = set.values.try_emplace(full, std::vector<double>(n, kNaN));
+      if (added) set.paths.push_back(full);
+      it->second[s] = value;
+    }
+    return scenario.at("seed").get<std::uint64_t>();
+  } catch (const json::exception& e) {  // a file wingman wrote holds these keys with these types
+    throw CheckInputError(fmt::format("{}: not a metrics.json of schema {}: {}", file.string(), kMetricsSchemaVersion,
+                                      e.what()));
   }
 }
 
@@ -117,32 +122,37 @@ void read_results_dir(MetricSet& set) {
     throw CheckInputError(fmt::format("{}: not a results directory (no metrics.json in it or in a "
                                       "variant directory) nor a Monte Carlo directory (no montecarlo.json)",
                                       set.dir.string()));
-  for (const auto& sub : subs) add_run(set, sub.empty() ? set.dir / "metrics.json" : set.dir / sub / "metrics.json",
-                                       sub.empty() ? "" : sub + "/", 0, 1);
-  const json j = read_metrics(set.dir / (subs.front().empty() ? "" : subs.front()) / "metrics.json");
-  set.seeds = {j["scenario"].value("seed", std::uint64_t{0})};
+  for (const auto& sub : subs) {
+    const std::uint64_t seed = add_run(set, set.dir / sub / "metrics.json", sub.empty() ? "" : sub + "/", 0, 1);
+    if (set.seeds.empty()) set.seeds = {seed};
+  }
 }
 
-void read_monte_carlo_dir(MetricSet& set) {
-  const fs::path file = set.dir / "montecarlo.json";
+// montecarlo.json's aggregated and failed seeds.
+void read_monte_carlo_seeds(MetricSet& set, const fs::path& file) {
   json mc;
   try {
     mc = read_json_file(file);
+    for (const json& s : mc.at("seeds")) set.seeds.push_back(s.get<std::uint64_t>());
+    for (const json& f : mc.value("failed_seeds", json::array()))
+      set.failures.push_back(fmt::format("{}: seed {}: {}", file.string(), f.at("seed").get<std::uint64_t>(),
+                                         f.value("reason", std::string("failed"))));
+  } catch (const json::exception& e) {
+    throw CheckInputError(fmt::format("{}: not a montecarlo.json of this wingman: {}", file.string(), e.what()));
   } catch (const std::runtime_error& e) {
     throw CheckInputError(e.what());
   }
-  if (!mc.is_object() || !mc.contains("seeds") || !mc["seeds"].is_array() || mc["seeds"].empty())
-    throw CheckInputError(fmt::format("{}: no 'seeds' (written by an older wingman montecarlo?)", file.string()));
-  for (const json& s : mc["seeds"]) set.seeds.push_back(s.get<std::uint64_t>());
-  if (mc.contains("failed_seeds") && mc["failed_seeds"].is_array())
-    for (const json& f : mc["failed_seeds"])
-      set.failures.push_back(fmt::format("{}: seed {}: {}", file.string(), f.value("seed", std::uint64_t{0}),
-                                         f.value("reason", std::string("failed"))));
+  if (set.seeds.empty()) throw CheckInputError(fmt::format("{}: no seed was aggregated", file.string()));
+}
+
+void read_monte_carlo_dir(MetricSet& set) {
+  read_monte_carlo_seeds(set, set.dir / "montecarlo.json");
   set.monte_carlo = true;
   const auto run = [&](std::uint64_t seed) { return set.dir / "runs" / fmt::format("seed{}", seed); };
   if (!fs::is_directory(run(set.seeds.front())))
     throw CheckInputError(fmt::format("{}: no such run directory", run(set.seeds.front()).string()));
   const auto subs = variant_dirs(run(set.seeds.front()));
+  if (subs.empty()) throw CheckInputError(fmt::format("{}: holds no metrics.json", run(set.seeds.front()).string()));
   for (std::size_t s = 0; s < set.seeds.size(); ++s)
     for (const auto& sub : subs)
       add_run(set, run(set.seeds[s]) / sub / "metrics.json", sub.empty() ? "" : sub + "/", s, set.seeds.size());
