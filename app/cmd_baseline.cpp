@@ -57,6 +57,10 @@ Subcommand add_baseline(CLI::App& parent) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--abs", o->options.abs, "Tolerance of the absolute rules (fractions and rates)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--rule", o->options.rule,
+                  "Rule of the errors, the NEES and counts: rel, or for a Monte Carlo directory mean (other seeds, "
+                  "single runs) or paired (the same seeds; the default there)")
+      ->check(CLI::IsMember({"rel", "mean", "paired"}));
   cmd->add_flag("--force", o->force, "Replace an existing baseline file");
   cmd->add_flag("--quiet,-q", o->quiet, "Print nothing but errors");
   return {cmd, [o] { return baseline_command(*o); }};

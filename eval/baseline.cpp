@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <optional>
 #include <set>
 
 #include "eval/montecarlo.hpp"
@@ -48,6 +49,16 @@ Default default_rule(const std::string& metric, bool monte_carlo) {
 // Shortest text that reads back to the same double.
 std::string num(double v) { return fmt::format("{}", v); }
 
+// The relative rule --rule names; CheckInputError for one the directory cannot give.
+Rule chosen_rule(const std::string& name, bool monte_carlo) {
+  if (name == "rel") return Rule::kRel;
+  if (name != "mean" && name != "paired")
+    throw CheckInputError(fmt::format("--rule {}: must be rel, mean or paired", name));
+  if (!monte_carlo)
+    throw CheckInputError(fmt::format("--rule {}: needs a Monte Carlo directory (the seeds' spread)", name));
+  return name == "mean" ? Rule::kMean : Rule::kPaired;
+}
+
 }  // namespace
 
 const char* rule_name(Rule r) {
@@ -72,6 +83,8 @@ const char* better_name(Better b) {
 }
 
 Baseline make_baseline(const MetricSet& set, const BaselineOptions& o) {
+  const std::optional<Rule> relative_rule =
+      o.rule.empty() ? std::nullopt : std::optional<Rule>(chosen_rule(o.rule, set.monte_carlo));
   Baseline b;
   b.metrics_schema = kMetricsSchemaVersion;
   b.kind = set.monte_carlo ? "montecarlo" : "results";
@@ -87,7 +100,8 @@ Baseline make_baseline(const MetricSet& set, const BaselineOptions& o) {
     BaselineEntry e;
     e.metric = metric;
     e.reference = s.mean;
-    e.rule = d.rule;
+    const bool relative = d.rule == Rule::kRel || d.rule == Rule::kMean || d.rule == Rule::kPaired;
+    e.rule = relative && !d.warn_only && relative_rule ? *relative_rule : d.rule;
     e.better = d.better;
     e.warn_only = d.warn_only;
     e.tolerance = d.tolerance;

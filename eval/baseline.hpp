@@ -57,6 +57,10 @@ struct Baseline {
 struct BaselineOptions {
   std::vector<std::string> metrics;  // globs; empty: default_metrics
   double rel = -1, abs = -1;         // tolerance of the relative / absolute rules; < 0: each metric's default
+  // The rule of every metric whose default is relative (rel, mean or paired: errors, the NEES,
+  // counts), e.g. mean for a Monte Carlo baseline that single runs or other seeds are checked
+  // against; empty: the default.
+  std::string rule;
 };
 
 const char* rule_name(Rule r);
@@ -64,7 +68,8 @@ const char* better_name(Better b);
 
 // A baseline of `set`: each chosen metric with a finite value, with its default rule (Monte
 // Carlo: paired; a results directory: rel, or abs for fractions and rates), direction and
-// on_breach (warn for timings). CheckInputError when a glob matches nothing.
+// on_breach (warn for timings). CheckInputError when a glob matches nothing, or for a rule that
+// the directory cannot give (mean or paired of a single run).
 Baseline make_baseline(const MetricSet& set, const BaselineOptions& options);
 
 // The YAML text of a baseline (every number written so that it reads back exactly).

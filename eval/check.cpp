@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "eval/montecarlo.hpp"
 #include "eval/paired.hpp"
@@ -31,6 +32,14 @@ std::string signed_num(double v) { return fmt::format("{:+.4g}", v); }
 
 // The sign of a worse change: "+" when lower is better, "-" when higher is, "+/-" for either.
 const char* worse_sign(Better b) { return b == Better::kLower ? "+" : b == Better::kHigher ? "-" : "+/-"; }
+
+// Where a ratio's interval must lie for a regression.
+std::string ratio_limit(const BaselineEntry& e) {
+  const double up = 1 + e.tolerance;
+  if (e.better == Better::kHigher) return fmt::format("below {:.4g}", 1 / up);
+  if (e.better == Better::kLower) return fmt::format("above {:.4g}", up);
+  return fmt::format("outside [{:.4g}, {:.4g}]", 1 / up, up);
+}
 
 std::string rule_text(const BaselineEntry& e) {
   const char* side = worse_sign(e.better);
@@ -71,26 +80,62 @@ Sample sample_of(const std::vector<double>& v) {
   return {s.mean, s.n > 1 ? s.std * s.std : kNaN, s.n};
 }
 
-// mean: Welch's 95 % interval of now's mean minus the baseline's; a side with one value borrows
-// the other side's spread (the same filter on other seeds).
-void judge_mean(const BaselineEntry& e, const Sample& now, CheckRow& row, const std::string& where) {
-  Sample ref{e.reference, e.n > 1 ? e.std * e.std : kNaN, e.n};
-  double dof_a = ref.n - 1, dof_b = now.n - 1;
-  if (!std::isfinite(ref.var)) ref.var = now.var, dof_a = dof_b;
-  Sample b = now;
-  if (!std::isfinite(b.var)) b.var = ref.var, dof_b = dof_a;
-  if (!std::isfinite(ref.var) || dof_a < 1)
+// Welch's 95 % interval of mean(b) - mean(a) from two samples' means, variances and sizes; a
+// side with one value borrows the other side's variance, and the interval then has that side's
+// degrees of freedom. nullopt when neither side has a spread.
+struct Interval {
+  double d = 0, lo = 0, hi = 0, dof = 0;
+};
+std::optional<Interval> welch(Sample a, Sample b) {
+  double dof_a = a.n - 1, dof_b = b.n - 1;
+  const bool borrowed = !std::isfinite(a.var) || !std::isfinite(b.var);
+  if (!std::isfinite(a.var)) a.var = b.var, dof_a = dof_b;
+  if (!std::isfinite(b.var)) b.var = a.var, dof_b = dof_a;
+  if (!std::isfinite(a.var) || dof_a < 1) return std::nullopt;
+  const double va = a.var / a.n, vb = b.var / b.n, se = std::sqrt(va + vb);
+  const double dof = borrowed ? std::min(dof_a, dof_b)
+                     : se > 0 ? (va + vb) * (va + vb) / (va * va / dof_a + vb * vb / dof_b)
+                              : dof_a + dof_b;
+  const double q = student_t_quantile(0.975, std::max(1.0, dof)), d = b.mean - a.mean;
+  return Interval{d, d - q * se, d + q * se, dof};
+}
+
+Sample log_sample(const std::vector<double>& v) {
+  std::vector<double> logs;
+  for (double x : v) logs.push_back(std::log(x));
+  return sample_of(logs);
+}
+
+// mean: the seeds' mean against the baseline's by Welch's interval. With every value > 0 and the
+// baseline's per-seed values, on the logs (errors and the NEES are skewed; their logs are close
+// to normal): the geometric-mean ratio against 1 + tolerance, as the paired rule judges it.
+void judge_mean(const BaselineEntry& e, const std::vector<double>& values, CheckRow& row, const std::string& where) {
+  std::vector<double> ref, now;
+  for (const auto& [seed, v] : e.per_seed) ref.push_back(v);
+  for (double v : values)
+    if (std::isfinite(v)) now.push_back(v);
+  const auto positive = [](const std::vector<double>& v) { return std::all_of(v.begin(), v.end(), [](double x) { return x > 0; }); };
+  const bool logs = ref.size() >= 2 && positive(ref) && positive(now);
+  const Sample a = logs ? log_sample(ref) : Sample{e.reference, e.n > 1 ? e.std * e.std : kNaN, e.n};
+  const Sample b = logs ? log_sample(now) : sample_of(now);
+  const auto ci = welch(a, b);
+  if (!ci)
     throw CheckInputError(fmt::format("{}: rule mean needs the spread of at least two seeds, in the baseline "
-                                      "(std, n) or in the results; use rel or abs for a single run", where));
-  const double va = ref.var / ref.n, vb = b.var / b.n, se = std::sqrt(va + vb);
-  const double dof = se > 0 ? (va + vb) * (va + vb) / (va * va / dof_a + vb * vb / dof_b) : dof_a + dof_b;
-  const double q = student_t_quantile(0.975, std::max(1.0, dof));
-  const double d = now.mean - ref.mean, lo = d - q * se, hi = d + q * se, margin = e.tolerance * std::abs(ref.mean);
-  row.verdict = judge_interval(lo, hi, margin, -margin, e.better);
-  row.detail = fmt::format("mean of {} seeds {:.6g} against {:.6g} (std {:.4g}, n {}): difference {}, 95% CI "
-                           "[{}, {}] (Welch, {:.1f} dof); a regression when the CI lies beyond {}{:.4g}",
-                           now.n, now.mean, ref.mean, e.std, e.n, signed_num(d), signed_num(lo), signed_num(hi), dof,
-                           worse_sign(e.better), margin);
+                                      "(per_seed, or std and n) or in the results; use rel or abs for a single run", where));
+  const std::string seeds = fmt::format("{} seed{} against {}", now.size(), now.size() == 1 ? "" : "s", e.n);
+  if (logs) {
+    const double up = 1 + e.tolerance;
+    row.verdict = judge_interval(std::exp(ci->lo), std::exp(ci->hi), up, 1 / up, e.better);
+    row.detail = fmt::format("{}: geometric-mean ratio now/baseline {:.4g}, 95% CI [{:.4g}, {:.4g}] (Welch on the "
+                             "logs, {:.1f} dof); a regression when the CI lies {}", seeds, std::exp(ci->d),
+                             std::exp(ci->lo), std::exp(ci->hi), ci->dof, ratio_limit(e));
+    return;
+  }
+  const double margin = e.tolerance * std::abs(a.mean);
+  row.verdict = judge_interval(ci->lo, ci->hi, margin, -margin, e.better);
+  row.detail = fmt::format("{}: mean {:.6g} against {:.6g}, difference {}, 95% CI [{}, {}] (Welch, {:.1f} dof); a "
+                           "regression when the CI lies beyond {}{:.4g}", seeds, b.mean, a.mean, signed_num(ci->d),
+                           signed_num(ci->lo), signed_num(ci->hi), ci->dof, worse_sign(e.better), margin);
 }
 
 // The seeds' values of a paired comparison and the sign test over the seeds that changed.
@@ -108,13 +153,10 @@ struct Pairs {
 void judge_ratio(const BaselineEntry& e, const Pairs& p, CheckRow& row) {
   const PairedRow r = compare_values(p.a, p.b);
   const double up = 1 + e.tolerance;
-  const std::string limit = e.better == Better::kHigher  ? fmt::format("below {:.4g}", 1 / up)
-                            : e.better == Better::kLower ? fmt::format("above {:.4g}", up)
-                                                         : fmt::format("outside [{:.4g}, {:.4g}]", 1 / up, up);
   row.verdict = judge_interval(r.ratio_lo, r.ratio_hi, up, 1 / up, e.better);
   row.detail = fmt::format("{} seeds in common: ratio now/baseline {:.4g}, 95% CI [{:.4g}, {:.4g}] (geometric mean); "
                            "{}; a regression when the CI lies {}", p.a.size(), r.ratio, r.ratio_lo, r.ratio_hi,
-                           p.counts(e.better), limit);
+                           p.counts(e.better), ratio_limit(e));
 }
 
 // paired with a value <= 0 (a ratio means nothing): the mean difference and its t interval.
@@ -181,7 +223,7 @@ CheckRow check_metric(const BaselineEntry& e, const std::vector<double>& values,
     row.detail = "the results have no value for it (null: an empty set of steps, or a filter that broke down)";
     return row;
   }
-  if (e.rule == Rule::kMean) judge_mean(e, now, row, where);
+  if (e.rule == Rule::kMean) judge_mean(e, values, row, where);
   else if (e.rule == Rule::kPaired) judge_paired(e, values, seeds, row, where);
   else judge_plain(e, row);
   if (row.verdict == Verdict::kFail && e.warn_only) row.verdict = Verdict::kWarn;

@@ -101,6 +101,27 @@ TEST(CheckRules, MeanDoesNotFailOnSeedNoise) {
   EXPECT_EQ(judge(e, {16.0}), Verdict::kFail);
 }
 
+// Baseline logs {0, 0.2, -0.2, 0} (mean 0, variance 0.02667 over 4 seeds), now the same shifted
+// by 1: Welch on the logs gives 6 dof and exp(1 +/- 2.446912 * 0.11547) = [2.049, 3.606].
+TEST(CheckRules, MeanOfPositiveValuesJudgesTheGeometricMeanRatio) {
+  auto e = entry(Rule::kMean, 1.0, 0.1);
+  e.n = 4;
+  e.per_seed = {{1, 1.0}, {2, std::exp(0.2)}, {3, std::exp(-0.2)}, {4, 1.0}};
+  const std::vector<double> shifted = {std::exp(1.0), std::exp(1.2), std::exp(0.8), std::exp(1.0)};
+  const CheckRow row = check_metric(e, shifted, {5, 6, 7, 8}, kFile);
+  EXPECT_EQ(row.verdict, Verdict::kFail);
+  EXPECT_NE(row.detail.find("ratio now/baseline 2.718, 95% CI [2.049, 3.606] (Welch on the logs, 6.0 dof)"),
+            std::string::npos) << row.detail;
+  e.tolerance = 1.5;  // up to x2.5 allowed: 2.049 is inside
+  EXPECT_EQ(judge(e, shifted), Verdict::kPass);
+  // One run borrows the baseline's spread and its 3 dof: exp(0.3 +/- 3.182446 * 0.182574) = [0.755, 2.413].
+  e.tolerance = 0.1;
+  const CheckRow one = check_metric(e, {std::exp(0.3)}, {9}, kFile);
+  EXPECT_EQ(one.verdict, Verdict::kPass);
+  EXPECT_NE(one.detail.find("95% CI [0.755, 2.413]"), std::string::npos) << one.detail;
+  EXPECT_NE(one.detail.find("3.0 dof"), std::string::npos) << one.detail;
+}
+
 TEST(CheckRules, MeanWithoutASpreadOnEitherSideIsBadInput) {
   auto e = entry(Rule::kMean, 10.0, 0.1);
   EXPECT_THROW(check_metric(e, {11.0}, {1}, kFile), CheckInputError);
