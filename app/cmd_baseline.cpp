@@ -25,6 +25,7 @@ struct BaselineCommand {
 };
 
 int baseline_command(const BaselineCommand& o) {
+  if (fs::is_directory(o.out)) throw UsageError(fmt::format("{}: is a directory; --out names the baseline file", o.out));
   if (fs::exists(o.out) && !o.force)
     throw UsageError(fmt::format("{}: already exists; pass --force to replace it", o.out));
   const eval::MetricSet set = eval::read_metric_set(o.dir);
