@@ -30,6 +30,7 @@ int baseline_command(const BaselineCommand& o) {
     throw UsageError(fmt::format("{}: already exists; pass --force to replace it", o.out));
   const eval::MetricSet set = eval::read_metric_set(o.dir);
   const eval::Baseline b = eval::make_baseline(set, o.options);
+  for (const auto& m : b.left_out) fmt::print(stderr, "note: {} has no value (null) in at least one run; left out\n", m);
   if (b.entries.empty())
     throw UsageError(fmt::format("{}: none of the chosen metrics has a value; choose others with --metrics", o.dir));
   if (fs::path(o.out).has_parent_path()) fs::create_directories(fs::path(o.out).parent_path());

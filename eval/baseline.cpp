@@ -95,7 +95,10 @@ Baseline make_baseline(const MetricSet& set, const BaselineOptions& o) {
   for (const auto& metric : chosen) {
     const std::vector<double>& v = set.values.at(metric);
     const Spread s = spread_of(v);
-    if (s.n != static_cast<int>(v.size()) || s.n == 0) continue;  // a value missing: nothing to hold it to
+    if (s.n != static_cast<int>(v.size()) || s.n == 0) {  // a value missing: nothing to hold it to
+      b.left_out.push_back(metric);
+      continue;
+    }
     const Default d = default_rule(metric, set.monte_carlo);
     BaselineEntry e;
     e.metric = metric;

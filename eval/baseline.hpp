@@ -52,6 +52,7 @@ struct Baseline {
   std::string scenario, software_version;
   std::vector<std::uint64_t> seeds;
   std::vector<BaselineEntry> entries;
+  std::vector<std::string> left_out;  // make_baseline: chosen metrics without a value (in some seed)
 };
 
 struct BaselineOptions {

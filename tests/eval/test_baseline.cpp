@@ -271,3 +271,20 @@ TEST(MetricSet, MonteCarloDirectoryGivesOneValuePerSeedAndItsFailedSeedsFail) {
 
 }  // namespace
 }  // namespace wingman::eval
+
+namespace wingman::eval {
+namespace {
+
+TEST(Baseline, AMetricWithoutAValueIsLeftOutAndNamed) {
+  MetricSet set;
+  set.paths = {"nees.mean", "table4.total.lead.mse.x"};
+  set.values = {{"nees.mean", {kNaN}}, {"table4.total.lead.mse.x", {0.25}}};
+  set.seeds = {1};
+  const Baseline b = make_baseline(set, {{"*"}, -1, -1});
+  ASSERT_EQ(b.entries.size(), 1u);
+  EXPECT_EQ(b.entries[0].metric, "table4.total.lead.mse.x");
+  EXPECT_EQ(b.left_out, std::vector<std::string>{"nees.mean"});
+}
+
+}  // namespace
+}  // namespace wingman::eval
