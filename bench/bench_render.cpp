@@ -2,11 +2,16 @@
 // the default world; Quad 1 at t = 20 s with the lead in view), colour and depth read back, per GL
 // backend, for a few MSAA, anisotropy and mipmap-filter settings. A backend that cannot make a
 // context here is reported as skipped with the reason.
+// Beside them the floor (BM_FloorEgl, BM_FloorOsMesa): one textured quad filling the same
+// 1000 x 1000 frame, drawn and read back as colour + metric depth through the same Renderer, so
+// that a scene's time over the floor's is the renderer's cost over what the machine and its GL
+// allow, one ratio that holds on any machine.
 #include <benchmark/benchmark.h>
 
 #include <sys/resource.h>
 
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 
 #include "render/gl_context.hpp"
@@ -65,6 +70,68 @@ void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
   state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
   state.SetLabel(ctx->description());
 }
+
+// The floor's scene: a 200 m square of the paper world's ground texture under a camera at 15 m
+// looking straight down, which it fills (the footprint is 75 m); no MSAA, no anisotropy, bilinear.
+render::Scene floor_scene() {
+  const sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic.yaml").front();
+  render::Scene world = render::build_scene(sim::describe_world(scn));
+  render::Scene s;
+  s.msaa = 1;
+  render::Material ground = world.materials.at(static_cast<std::size_t>(world.static_meshes.front().material));
+  ground.anisotropy = 1;
+  ground.trilinear = false;
+  s.materials = {ground};
+  render::Mesh quad;
+  const Eigen::Vector3d up(0, 0, 1), white(1, 1, 1);
+  quad.add({-100, -100, 0}, up, {0, 0}, white);
+  quad.add({100, -100, 0}, up, {8, 0}, white);
+  quad.add({100, 100, 0}, up, {8, 8}, white);
+  quad.add({-100, 100, 0}, up, {0, 8}, white);
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  quad.material = 0;
+  s.static_meshes = {quad};
+  return s;
+}
+
+void render_floor(benchmark::State& state, render::GlBackend backend) {
+  std::unique_ptr<render::GlContext> ctx;
+  try {
+    ctx = render::create_gl_context(backend);
+  } catch (const render::GlContextError& e) {
+    state.SkipWithError(e.what());
+    for (auto _ : state) {
+    }
+    return;
+  }
+  render::Renderer renderer(*ctx, floor_scene());
+  geometry::CameraPose pose;
+  pose.R_CW = Eigen::Vector3d(1, -1, -1).asDiagonal();  // optical axis down, image x along world x
+  pose.position = {0, 0, 15};
+  const render::CameraView view{geometry::PinholeCamera(200.1, 200.1, 500, 500, 1000, 1000), pose};
+  const render::Frame first = renderer.render(view);  // warm-up, and the floor's own check
+  if (cv::countNonZero(first.depth) != first.depth.rows * first.depth.cols) {
+    state.SkipWithError("the floor's quad does not fill the frame");
+    for (auto _ : state) {
+    }
+    return;
+  }
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) {
+    render::Frame f = renderer.render(view);
+    benchmark::DoNotOptimize(f.rgb.data);
+    benchmark::DoNotOptimize(f.depth.data);
+  }
+  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()),
+                                             benchmark::Counter::kIsRate);
+  state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
+  state.SetLabel(ctx->description());
+}
+
+void BM_FloorEgl(benchmark::State& s) { render_floor(s, render::GlBackend::Egl); }
+void BM_FloorOsMesa(benchmark::State& s) { render_floor(s, render::GlBackend::OsMesa); }
+BENCHMARK(BM_FloorEgl)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FloorOsMesa)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_RenderEgl(benchmark::State& s) { render_paper_camera(s, render::GlBackend::Egl); }
 void BM_RenderOsMesa(benchmark::State& s) { render_paper_camera(s, render::GlBackend::OsMesa); }
