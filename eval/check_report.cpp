@@ -33,7 +33,8 @@ std::string lower(std::string s) {
 
 bool passed(const CheckRow& row) { return row.verdict == Verdict::kPass || row.verdict == Verdict::kImproved; }
 
-// The testcase's class: the variant ("multi/table4..." -> wingman.check.multi), or the scenario.
+// The testcase's class: wingman.check.<variant> ("multi/table4..." -> wingman.check.multi), or
+// wingman.check for a scenario without variants.
 std::string junit_class(const CheckRow& row) {
   const auto slash = row.metric.find('/');
   return slash == std::string::npos ? "wingman.check" : "wingman.check." + row.metric.substr(0, slash);
