@@ -37,28 +37,22 @@ double process_cpu_seconds() {
          1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
-  sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic.yaml").front();
-  scn.world.image.msaa = static_cast<int>(state.range(0));
-  scn.world.texture.anisotropy = static_cast<double>(state.range(1));
-  scn.world.texture.filter =
-      state.range(2) ? sim::TextureSpec::Filter::Trilinear : sim::TextureSpec::Filter::Bilinear;
-  std::unique_ptr<render::GlContext> ctx;
+// A context of the backend, or nullptr with the benchmark skipped and the reason given.
+std::unique_ptr<render::GlContext> context_or_skip(benchmark::State& state, render::GlBackend backend) {
   try {
-    ctx = render::create_gl_context(backend);
+    return render::create_gl_context(backend);
   } catch (const render::GlContextError& e) {
     state.SkipWithError(e.what());
     for (auto _ : state) {
     }
-    return;
+    return nullptr;
   }
-  render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
-  const sim::OpenLoopTruth truth(scn);
-  const double t = 20.0;
-  const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t),
-                                truth.camera(0, t).position};
-  const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
-  renderer.render(view, lead);  // warm-up: framebuffers, shader compilation
+}
+
+// Renders the view over and over (after one warm-up frame: framebuffers, shader compilation),
+// reporting frames per second and the process's CPU per frame.
+void time_frames(benchmark::State& state, render::Renderer& renderer, const render::CameraView& view,
+                 const std::optional<render::LeadPose>& lead) {
   const double cpu0 = process_cpu_seconds();
   for (auto _ : state) {
     render::Frame f = renderer.render(view, lead);
@@ -68,7 +62,25 @@ void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
   state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()),
                                              benchmark::Counter::kIsRate);
   state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
-  state.SetLabel(ctx->description());
+  state.SetLabel(renderer.context().description());
+}
+
+void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
+  sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic.yaml").front();
+  scn.world.image.msaa = static_cast<int>(state.range(0));
+  scn.world.texture.anisotropy = static_cast<double>(state.range(1));
+  scn.world.texture.filter =
+      state.range(2) ? sim::TextureSpec::Filter::Trilinear : sim::TextureSpec::Filter::Bilinear;
+  const auto ctx = context_or_skip(state, backend);
+  if (!ctx) return;
+  render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
+  const sim::OpenLoopTruth truth(scn);
+  const double t = 20.0;
+  const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t),
+                                truth.camera(0, t).position};
+  const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
+  renderer.render(view, lead);  // warm-up
+  time_frames(state, renderer, view, lead);
 }
 
 // The floor's scene: a 200 m square of the paper world's ground texture under a camera at 15 m
@@ -95,15 +107,8 @@ render::Scene floor_scene() {
 }
 
 void render_floor(benchmark::State& state, render::GlBackend backend) {
-  std::unique_ptr<render::GlContext> ctx;
-  try {
-    ctx = render::create_gl_context(backend);
-  } catch (const render::GlContextError& e) {
-    state.SkipWithError(e.what());
-    for (auto _ : state) {
-    }
-    return;
-  }
+  const auto ctx = context_or_skip(state, backend);
+  if (!ctx) return;
   render::Renderer renderer(*ctx, floor_scene());
   geometry::CameraPose pose;
   pose.R_CW = Eigen::Vector3d(1, -1, -1).asDiagonal();  // optical axis down, image x along world x
@@ -116,16 +121,7 @@ void render_floor(benchmark::State& state, render::GlBackend backend) {
     }
     return;
   }
-  const double cpu0 = process_cpu_seconds();
-  for (auto _ : state) {
-    render::Frame f = renderer.render(view);
-    benchmark::DoNotOptimize(f.rgb.data);
-    benchmark::DoNotOptimize(f.depth.data);
-  }
-  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()),
-                                             benchmark::Counter::kIsRate);
-  state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
-  state.SetLabel(ctx->description());
+  time_frames(state, renderer, view, std::nullopt);
 }
 
 void BM_FloorEgl(benchmark::State& s) { render_floor(s, render::GlBackend::Egl); }
