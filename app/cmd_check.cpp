@@ -22,7 +22,7 @@ namespace {
 
 struct CheckCommand {
   std::string dir, baseline, against, junit, markdown, json;
-  bool quiet = false;
+  bool quiet = false, verbose = false;
 };
 
 // The determinism check as a report: one row per data file.
@@ -69,7 +69,7 @@ int check_command(const CheckCommand& o) {
   write_report(o.junit, eval::check_junit(r));
   write_report(o.markdown, eval::check_markdown(r));
   write_report(o.json, eval::check_json(r));
-  if (o.against.empty() && (!o.quiet || r.failed > 0)) fmt::print("{}", eval::format_check(r));
+  if (o.against.empty() && (!o.quiet || r.failed > 0)) fmt::print("{}", eval::format_check(r, o.verbose));
   return r.failed > 0 ? 1 : 0;
 }
 
@@ -87,6 +87,7 @@ Subcommand add_check(CLI::App& parent) {
   cmd->add_option("--markdown", o->markdown, "Also write a Markdown report (a pull-request comment) to this file");
   cmd->add_option("--json", o->json, "Also write the verdicts as JSON to this file");
   cmd->add_flag("--quiet,-q", o->quiet, "Print the table only when something failed");
+  cmd->add_flag("--verbose,-v", o->verbose, "Print the numbers behind every verdict, passes included");
   return {cmd, [o] { return check_command(*o); }};
 }
 

@@ -56,8 +56,8 @@ CheckRow check_metric(const BaselineEntry& e, const std::vector<double>& values,
 CheckReport check_against_baseline(const MetricSet& results, const Baseline& baseline);
 
 // The table printed on stdout: metric, baseline, now, change, rule, verdict, then the details
-// of every row that did not pass, and a summary line.
-std::string format_check(const CheckReport& r);
+// of every row that did not pass (of every row with `all_details`), and a summary line.
+std::string format_check(const CheckReport& r, bool all_details = false);
 // Markdown for a pull-request comment: a summary line and the same table.
 std::string check_markdown(const CheckReport& r);
 // JUnit XML (testsuites/testsuite/testcase, a <failure> with the numbers for each regression;

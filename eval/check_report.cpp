@@ -42,7 +42,7 @@ std::string junit_class(const CheckRow& row) {
 
 }  // namespace
 
-std::string format_check(const CheckReport& r) {
+std::string format_check(const CheckReport& r, bool all_details) {
   std::size_t width = 6;
   for (const auto& row : r.rows) width = std::max(width, row.metric.size());
   std::string s = fmt::format("{} against {}\n", r.results.string(), r.baseline.string());
@@ -54,7 +54,8 @@ std::string format_check(const CheckReport& r) {
   for (const auto& row : r.rows)
     if (!passed(row)) s += fmt::format("{} {}: {}\n", verdict_name(row.verdict), row.metric, row.detail);
   for (const auto& row : r.rows)
-    if (row.verdict == Verdict::kImproved) s += fmt::format("improved {}: {}\n", row.metric, row.detail);
+    if (row.verdict == Verdict::kImproved || (all_details && row.verdict == Verdict::kPass))
+      s += fmt::format("{} {}: {}\n", verdict_name(row.verdict), row.metric, row.detail);
   return s + summary_line(r) + "\n";
 }
 

@@ -37,9 +37,12 @@ std::string worsened_smoke() {
 TEST(CheckCli, ShippedSmokePassesItsBaselineAndAWorsenedFilterFails) {
   TempDir tmp;
   const fs::path good = run_smoke(tmp, "good");
-  const RunResult pass = run_wingman({"check", good.string(), "--baseline", kSmokeBaseline.string()}, tmp.path());
+  const RunResult pass =
+      run_wingman({"check", good.string(), "--baseline", kSmokeBaseline.string(), "--verbose"}, tmp.path());
   EXPECT_EQ(pass.exit_code, 0) << pass.output;
   EXPECT_NE(pass.output.find("0 failed"), std::string::npos) << pass.output;
+  // --verbose: the numbers behind a pass too.
+  EXPECT_NE(pass.output.find("pass multi/table4.total.lead.mse.x: "), std::string::npos) << pass.output;
 
   const fs::path worse = run_smoke(tmp, "worse", worsened_smoke());
   const RunResult fail = run_wingman({"check", worse.string(), "--baseline", kSmokeBaseline.string()}, tmp.path());
