@@ -97,6 +97,84 @@ BENCHMARK(BM_DetectDescribe)
     ->Arg(static_cast<int>(DetectorKind::GfttOrb))
     ->Unit(benchmark::kMillisecond);
 
+// Where ORB's time goes, as FeatureExtractor configures it (2000 candidates for 1000 features,
+// FAST threshold 12, 4 levels of 1.2): detection alone over the frame, describing 1000 kept
+// keypoints alone, and detection restricted to a quarter of the frame (4 of 16 cells of 250 px,
+// one per row) by a mask and by cropping each cell with a 48 px border (ORB's 31 px patch at
+// level 3 needs 31 x 1.2^2 = 45). What active search would save depends on the last two.
+cv::Ptr<cv::ORB> paper_orb() {
+  const FeatureSettings s;
+  return cv::ORB::create(static_cast<int>(s.max_features * s.oversample), s.orb_scale_factor, s.orb_levels, 31, 0,
+                         2, cv::ORB::HARRIS_SCORE, 31, s.orb_fast_threshold);
+}
+
+const cv::Mat& grey_a() {
+  static const cv::Mat g = [] {
+    cv::Mat m;
+    cv::cvtColor(frame_a(), m, cv::COLOR_BGR2GRAY);
+    return m;
+  }();
+  return g;
+}
+
+// The quarter of the frame: cell (row r, column (r * 5) % 4) of a 4 x 4 grid, for r = 0..3.
+std::vector<cv::Rect> quarter_cells() {
+  std::vector<cv::Rect> cells;
+  for (int r = 0; r < 4; ++r) cells.emplace_back(250 * ((r * 5) % 4), 250 * r, 250, 250);
+  return cells;
+}
+
+void BM_OrbDetectOnly(benchmark::State& state) {
+  const auto orb = paper_orb();
+  std::vector<cv::KeyPoint> kps;
+  for (auto _ : state) orb->detect(grey_a(), kps);
+  state.counters["keypoints"] = static_cast<double>(kps.size());
+}
+BENCHMARK(BM_OrbDetectOnly)->Unit(benchmark::kMillisecond);
+
+void BM_OrbDescribeOnly(benchmark::State& state) {
+  const auto orb = paper_orb();
+  std::vector<cv::KeyPoint> all;
+  orb->detect(grey_a(), all);
+  const auto kept = bucket_keypoints(all, 1000, 1000, 8, 8, 1000);
+  cv::Mat desc;
+  for (auto _ : state) {
+    std::vector<cv::KeyPoint> kps = kept;
+    orb->compute(grey_a(), kps, desc);
+  }
+  state.counters["keypoints"] = desc.rows;
+}
+BENCHMARK(BM_OrbDescribeOnly)->Unit(benchmark::kMillisecond);
+
+void BM_OrbDetectQuarterMasked(benchmark::State& state) {
+  const auto orb = paper_orb();
+  cv::Mat mask(grey_a().size(), CV_8U, cv::Scalar(0));
+  for (const auto& c : quarter_cells()) mask(c).setTo(255);
+  std::vector<cv::KeyPoint> kps;
+  for (auto _ : state) orb->detect(grey_a(), kps, mask);
+  state.counters["keypoints"] = static_cast<double>(kps.size());
+}
+BENCHMARK(BM_OrbDetectQuarterMasked)->Unit(benchmark::kMillisecond);
+
+void BM_OrbDetectQuarterCropped(benchmark::State& state) {
+  const auto orb = paper_orb();
+  orb->setMaxFeatures(2000 / 4);  // each cell its share
+  constexpr int kBorder = 48;
+  const cv::Rect frame(0, 0, grey_a().cols, grey_a().rows);
+  std::size_t n = 0;
+  for (auto _ : state) {
+    n = 0;
+    for (const auto& c : quarter_cells()) {
+      const cv::Rect crop = cv::Rect(c.x - kBorder, c.y - kBorder, c.width + 2 * kBorder, c.height + 2 * kBorder) & frame;
+      std::vector<cv::KeyPoint> kps;
+      orb->detect(grey_a()(crop), kps);
+      n += kps.size();
+    }
+  }
+  state.counters["keypoints"] = static_cast<double>(n);
+}
+BENCHMARK(BM_OrbDetectQuarterCropped)->Unit(benchmark::kMillisecond);
+
 // 150 landmarks from frame a's features (rays met with the ground), predicted exactly in frame b
 // with S = 9 I, tracked among frame b's 1000 features.
 void BM_Track(benchmark::State& state) {
