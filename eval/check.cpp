@@ -100,6 +100,11 @@ std::optional<Interval> welch(Sample a, Sample b) {
   return Interval{d, d - q * se, d + q * se, dof};
 }
 
+// Whether a ratio (or a log) of these values means something.
+bool all_positive(const std::vector<double>& v) {
+  return std::all_of(v.begin(), v.end(), [](double x) { return x > 0; });
+}
+
 Sample log_sample(const std::vector<double>& v) {
   std::vector<double> logs;
   for (double x : v) logs.push_back(std::log(x));
@@ -114,8 +119,7 @@ void judge_mean(const BaselineEntry& e, const std::vector<double>& values, Check
   for (const auto& [seed, v] : e.per_seed) ref.push_back(v);
   for (double v : values)
     if (std::isfinite(v)) now.push_back(v);
-  const auto positive = [](const std::vector<double>& v) { return std::all_of(v.begin(), v.end(), [](double x) { return x > 0; }); };
-  const bool logs = ref.size() >= 2 && positive(ref) && positive(now);
+  const bool logs = ref.size() >= 2 && all_positive(ref) && all_positive(now);
   const Sample a = logs ? log_sample(ref) : Sample{e.reference, e.n > 1 ? e.std * e.std : kNaN, e.n};
   const Sample b = logs ? log_sample(now) : sample_of(now);
   const auto ci = welch(a, b);
@@ -187,10 +191,7 @@ void judge_paired(const BaselineEntry& e, const std::vector<double>& values, con
   for (std::size_t i = 0; i < p.a.size(); ++i)
     if (p.b[i] != p.a[i]) ++((p.b[i] > p.a[i]) == lower ? p.worse : p.better);
   if (p.worse + p.better > 0) p.sign_p = sign_test_p(p.worse, p.worse + p.better);
-  const auto positive = [](const std::vector<double>& v) {
-    return std::all_of(v.begin(), v.end(), [](double x) { return x > 0; });
-  };
-  if (positive(p.a) && positive(p.b)) judge_ratio(e, p, row);
+  if (all_positive(p.a) && all_positive(p.b)) judge_ratio(e, p, row);
   else judge_difference(e, p, row);
 }
 

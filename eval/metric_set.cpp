@@ -17,11 +17,12 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Keys that are not metrics: identity, conventions, per-step series and indices.
+// Keys that are not metrics: identity, conventions, a failure's step and time, phase indices
+// and bounds. Numeric series (per_step, count_per_step, per_phase_mean, histogram counts) need no
+// entry: flatten_array keeps only the named vectors below.
 const std::set<std::string> kSkippedKeys = {
     "schema_version", "conventions", "software_version", "scenario", "numerical_failure",
-    "per_step", "count_per_step", "phase", "per_agent", "per_phase_mean", "accepted_error_histogram",
-    "t_start", "t_end", "t_from", "config", "components"};
+    "phase", "t_start", "t_end", "t_from", "config", "components"};
 
 // Numeric arrays that are vectors with named components.
 const char* const kXyz[] = {"x", "y", "z"};

@@ -196,11 +196,16 @@ def mut_replace(rng, text, ents):
             f"with {shorten(new)}")
 
 
-def mut_delete(rng, text, ents):
+def keyed_entry(rng, ents):
+    """A random mapping entry (one with a key), or None when there is none."""
     cands = [e for e in ents if e.key is not None]
-    if not cands:
+    return rng.choice(cands) if cands else None
+
+
+def mut_delete(rng, text, ents):
+    e = keyed_entry(rng, ents)
+    if e is None:
         return None
-    e = rng.choice(cands)
     desc = f"delete key {e.path} (line {e.key.start_mark.line + 1})"
     if e.parent.flow_style:
         return delete_flow_pair(text, e), desc
@@ -233,10 +238,9 @@ def entry_text(lines: list, e: Entry) -> tuple:
 
 
 def mut_duplicate(rng, text, ents):
-    cands = [e for e in ents if e.key is not None]
-    if not cands:
+    e = keyed_entry(rng, ents)
+    if e is None:
         return None
-    e = rng.choice(cands)
     desc = f"duplicate key {e.path} (line {e.key.start_mark.line + 1})"
     if e.parent.flow_style:
         t = e.value.end_mark.index
@@ -259,10 +263,9 @@ def unknown_key(rng, ents) -> str:
 
 
 def mut_unknown(rng, text, ents):
-    cands = [e for e in ents if e.key is not None]
-    if not cands:
+    e = keyed_entry(rng, ents)
+    if e is None:
         return None
-    e = rng.choice(cands)
     key = unknown_key(rng, ents)
     desc = f"add unknown key {shorten(key)} next to {e.path}"
     if e.parent.flow_style:
