@@ -43,6 +43,7 @@ StageTimes FrameMeasurements::begin_step(int k, double t, const slam::Estimator&
   const Eigen::Vector3d lead_W = truth_.lead(t).position;
   for (int j = 0; j < frontend_.num_cameras(); ++j) {
     lead_[j] = frontend_.lead(j);
+    record_.searched_fraction_sum += frontend_.searched_fraction(j);
     const auto uv_true = labeller_.lead(lead_[j], frontend_.model(j), now_[j], lead_W, record_);
     if (uv_true && cfg_.frontend.oracle_pixels) lead_[j] = *uv_true;
   }

@@ -87,12 +87,33 @@ double VisionFrontend::detect(int cam, const render::Frame& frame, const slam::E
   } else if (predicted) {
     exclude.push_back(predicted_lead_box(*predicted, c.model.fx(), p_est.z(), cfg_));
   }
-  c.features = features_.detect(grey, exclude);
+  c.features = detect_features(cam, grey, exclude, est);
   const double ms = ms_since(t0);
   c.marks = {};
   c.preds.clear();  // a camera whose landmarks are switched off tracks nothing this step
   c.used.assign(c.features.size(), false);
   return ms;
+}
+
+// The whole frame, or with active search the gates of the landmarks the filter predicts in this
+// camera and blocks for the new landmarks the loop will ask for: target_per_camera less what is
+// in view, for the camera with the largest deficit (cooperative pairs ask for the larger of theirs).
+vision::Features VisionFrontend::detect_features(int cam, const cv::Mat& grey,
+                                                 const std::vector<vision::ExclusionBox>& exclude,
+                                                 const slam::Estimator& est) {
+  Cam& c = cams_[cam];
+  c.searched = 1.0;
+  if (!cfg_.frontend.active_search.enabled) return features_.detect(grey, exclude);
+  const int target = cfg_.estimator.map.target_per_camera;
+  std::vector<vision::LandmarkPrediction> preds;
+  for (const auto& p : est.predictions_in_view(cam)) preds.push_back({p.id, p.uv, p.S});
+  int needed = target - static_cast<int>(preds.size());
+  for (int j = 0; j < num_cameras(); ++j)
+    if (j != cam) needed = std::max(needed, target - static_cast<int>(est.predictions_in_view(j).size()));
+  const auto plan = vision::plan_search(grey.size(), preds, needed, features_.crop_margin(), tracking_,
+                                        cfg_.frontend.active_search);
+  c.searched = plan.fraction;
+  return plan.whole_frame ? features_.detect(grey, exclude) : features_.detect_in(grey, plan.regions, exclude);
 }
 
 std::vector<VisionFrontend::Feature> VisionFrontend::track(int cam,

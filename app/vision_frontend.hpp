@@ -68,6 +68,8 @@ class VisionFrontend {
   void removed(slam::LandmarkId id) { store_.remove(id); }
 
   const Marks& marks(int cam) const { return cams_[cam].marks; }
+  // The last detection's share of the frame's pixels that the detector processed (active search).
+  double searched_fraction(int cam) const { return cams_[cam].searched; }
 
  private:
   struct Cam {
@@ -77,7 +79,10 @@ class VisionFrontend {
     std::vector<bool> used;                         // keypoints taken by tracking or matching
     std::optional<Eigen::Vector2d> lead;
     Marks marks;
+    double searched = 1.0;
   };
+  vision::Features detect_features(int cam, const cv::Mat& grey, const std::vector<vision::ExclusionBox>& exclude,
+                                   const slam::Estimator& est);
   const RunConfig& cfg_;
   vision::FeatureExtractor features_;
   vision::LeadDetector lead_;

@@ -203,6 +203,7 @@ Metrics compute_metrics(const RunRecord& run) {
                                          std::end(FrontendMetrics::kErrorBins), e);
       ++m.frontend.accepted_error_histogram[bin - std::begin(FrontendMetrics::kErrorBins)];
     }
+    if (f.frames > 0) m.frontend.searched_fraction = f.searched_fraction_sum / static_cast<double>(f.frames);
     if (run.steps.size() > 1)
       m.frontend.detect_busy_ms_per_step = f.detect_busy_ms / static_cast<double>(run.steps.size() - 1);
   }

@@ -73,6 +73,7 @@ struct FrontendMetrics {
   Stats lead_error_px;
   long lead_in_view = 0, lead_detected = 0, lead_false = 0, frames = 0;
   double detect_busy_ms_per_step = kNaN;  // detection's whole duration (timings_ms.detect: exposed part)
+  double searched_fraction = kNaN;  // mean share of a frame's pixels the feature detector processed
   Stats accepted_error_px;  // tracked correspondences the filter accepted, to their true projection
   // Of those, how many fall in [0,1), [1,2), [2,3), [3,5), [5,10), [10,inf) px.
   std::vector<long> accepted_error_histogram;

@@ -110,6 +110,9 @@ struct FrontendRecord {
   long lead_false = 0;    // detections farther than lead_match_px, or with the lead out of view
   double lead_match_px = 10;
   double detect_busy_ms = 0;  // detection's whole duration over the run (partly behind rendering)
+  // Active search: the share of each frame's pixels the feature detector processed, summed over
+  // the frames (1 per frame detected whole).
+  double searched_fraction_sum = 0;
   std::vector<double> lead_error_px;  // detection to true projection, for the lead_detected frames
   // Tracked correspondences the filter accepted: pixel to the landmark's true projection (NaN when
   // the landmark has no truth). Says whether the labelled outliers are near misses or mismatches.

@@ -169,6 +169,7 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
                      {"lead_detection_rate", num(f.lead_detection_rate)},
                      {"lead_error_px", stats(f.lead_error_px)},
                      {"detect_busy_ms_per_step", num(f.detect_busy_ms_per_step)},
+                     {"searched_fraction", num(f.searched_fraction)},
                      {"accepted_error_px", stats(f.accepted_error_px)},
                      {"accepted_error_histogram",
                       {{"bin_edges_px", FrontendMetrics::kErrorBins}, {"counts", f.accepted_error_histogram}}}};

@@ -52,7 +52,7 @@ void Estimator::predict(double dt) {
   check_state(s_, "the prediction");
 }
 
-std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
+std::vector<LandmarkPrediction> Estimator::predictions_in_view(int cam) const {
   std::vector<LandmarkPrediction> out;
   const CameraRig& rig = cams_[cam];
   for (const auto& lm : s_.landmarks()) {
@@ -61,8 +61,13 @@ std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
     auto m = landmark_measurement(s_, lm, cam, rig, *uv, cfg_.measurement_noise.pixel_sigma);
     if (!m) continue;
     out.push_back({lm.id, *uv, innovation_covariance(s_, *m)});
-    tracks_[lm.id].expected = true;
   }
+  return out;
+}
+
+std::vector<LandmarkPrediction> Estimator::landmarks_in_view(int cam) {
+  auto out = predictions_in_view(cam);
+  for (const auto& p : out) tracks_[p.id].expected = true;
   return out;
 }
 

@@ -65,6 +65,9 @@ class Estimator {
   // Landmarks predicted inside camera `cam`'s image (with the margin); records them as expected
   // to be matched this step, for map management.
   std::vector<LandmarkPrediction> landmarks_in_view(int cam);
+  // The same predictions without recording anything: what the frontend's active search plans
+  // its regions from before the step's measurements are taken.
+  std::vector<LandmarkPrediction> predictions_in_view(int cam) const;
   // Landmark correspondences (1-point RANSAC and gating) together with the lead's projections
   // (eq. 5-6) of the same frames, which share the gimbal noise with them.
   VisualUpdateResult update_visual(const std::vector<Correspondence>& candidates,

@@ -103,6 +103,36 @@ float intensity_centroid_angle(const cv::Mat& grey, cv::Point2f pt) {
   return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
 }
 
+cv::Mat to_grey(const cv::Mat& image) {
+  if (image.empty()) throw std::invalid_argument("FeatureExtractor::detect: empty image");
+  cv::Mat grey;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4) cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  else grey = image;
+  if (grey.depth() != CV_8U)
+    throw std::invalid_argument("FeatureExtractor::detect: expected an 8-bit image, got depth " +
+                                std::to_string(grey.depth()));
+  return grey;
+}
+
+// The detector's mask: zero inside the exclusion boxes (with a pixel to spare), empty without.
+cv::Mat exclusion_mask(cv::Size size, const std::vector<ExclusionBox>& exclude) {
+  cv::Mat mask;
+  if (exclude.empty()) return mask;
+  mask = cv::Mat(size, CV_8U, cv::Scalar(255));
+  for (const auto& b : exclude) {
+    const cv::Rect r(cvFloor(b.centre.x() - b.half_width), cvFloor(b.centre.y() - b.half_height),
+                     cvCeil(2 * b.half_width) + 2, cvCeil(2 * b.half_height) + 2);
+    mask(r & cv::Rect(0, 0, size.width, size.height)).setTo(0);
+  }
+  return mask;
+}
+
+bool outside_boxes(const cv::KeyPoint& k, const std::vector<ExclusionBox>& exclude) {
+  const Eigen::Vector2d uv(k.pt.x, k.pt.y);
+  return std::none_of(exclude.begin(), exclude.end(), [&](const ExclusionBox& b) { return b.contains(uv); });
+}
+
 }  // namespace
 
 void orb_keypoints_to_pixel_centres(std::vector<cv::KeyPoint>& keypoints, cv::Size image,
@@ -135,26 +165,40 @@ double default_max_descriptor_distance(const cv::Mat& descriptors) {
 
 FeatureExtractor::FeatureExtractor(const FeatureSettings& settings) : cfg_(settings) {
   cfg_.validate();
-  const int n = static_cast<int>(std::ceil(cfg_.max_features * cfg_.oversample));
+  detector_ = make_detector(static_cast<int>(std::ceil(cfg_.max_features * cfg_.oversample)), kOrbEdge);
+  if (cfg_.kind == DetectorKind::GfttOrb)
+    describer_ = cv::ORB::create(static_cast<int>(std::ceil(cfg_.max_features * cfg_.oversample)),
+                                 cfg_.orb_scale_factor, 1);
+  else
+    describer_ = detector_;  // ORB describes with its own pyramid; AKAZE and SIFT what they detect
+}
+
+cv::Ptr<cv::Feature2D> FeatureExtractor::make_detector(int n, int orb_edge) const {
   switch (cfg_.kind) {
     case DetectorKind::Orb:
-      detector_ = cv::ORB::create(n, cfg_.orb_scale_factor, cfg_.orb_levels, 31, 0, 2,
-                                  cv::ORB::HARRIS_SCORE, 31, cfg_.orb_fast_threshold);
-      describer_ = detector_;
-      break;
+      return cv::ORB::create(n, cfg_.orb_scale_factor, cfg_.orb_levels, orb_edge, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+                             cfg_.orb_fast_threshold);
     case DetectorKind::GfttOrb:
-      detector_ = cv::GFTTDetector::create(n, cfg_.gftt_quality, cfg_.gftt_min_distance, 3, false);
-      describer_ = cv::ORB::create(n, cfg_.orb_scale_factor, 1);
-      break;
+      return cv::GFTTDetector::create(n, cfg_.gftt_quality, cfg_.gftt_min_distance, 3, false);
     case DetectorKind::Akaze:
-      detector_ = cv::AKAZE::create(cv::AKAZE::DESCRIPTOR_MLDB, 0, 3,
-                                    static_cast<float>(cfg_.akaze_threshold));
-      break;
+      return cv::AKAZE::create(cv::AKAZE::DESCRIPTOR_MLDB, 0, 3, static_cast<float>(cfg_.akaze_threshold));
     case DetectorKind::Sift:
-      detector_ = cv::SIFT::create(n, 3, cfg_.sift_contrast);
-      break;
+      return cv::SIFT::create(n, 3, cfg_.sift_contrast);
   }
-  if (!describer_) describer_ = detector_;  // AKAZE and SIFT describe what they detect
+  throw std::logic_error("FeatureExtractor: unknown detector kind");
+}
+
+int FeatureExtractor::crop_margin() const {
+  switch (cfg_.kind) {
+    case DetectorKind::Orb:
+      return static_cast<int>(std::ceil(kOrbCropEdge * std::pow(cfg_.orb_scale_factor, cfg_.orb_levels - 1))) + 1;
+    case DetectorKind::GfttOrb:
+      return 32;  // ORB's 31 px patch at one level
+    case DetectorKind::Akaze:
+    case DetectorKind::Sift:
+      return 64;  // their coarse octaves see less context in a crop than in the frame
+  }
+  return 64;
 }
 
 int FeatureExtractor::norm() const {
@@ -162,28 +206,9 @@ int FeatureExtractor::norm() const {
 }
 
 Features FeatureExtractor::detect(const cv::Mat& image, const std::vector<ExclusionBox>& exclude) const {
-  if (image.empty()) throw std::invalid_argument("FeatureExtractor::detect: empty image");
-  cv::Mat grey;
-  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4) cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
-  else grey = image;
-  if (grey.depth() != CV_8U)
-    throw std::invalid_argument("FeatureExtractor::detect: expected an 8-bit image, got depth " +
-                                std::to_string(grey.depth()));
-
-  cv::Mat mask;
-  if (!exclude.empty()) {
-    mask = cv::Mat(grey.size(), CV_8U, cv::Scalar(255));
-    for (const auto& b : exclude) {
-      const cv::Rect r(cvFloor(b.centre.x() - b.half_width), cvFloor(b.centre.y() - b.half_height),
-                       cvCeil(2 * b.half_width) + 2, cvCeil(2 * b.half_height) + 2);
-      mask(r & cv::Rect(0, 0, grey.cols, grey.rows)).setTo(0);
-    }
-  }
-  auto outside = [&](const cv::KeyPoint& k) {
-    const Eigen::Vector2d uv(k.pt.x, k.pt.y);
-    return std::none_of(exclude.begin(), exclude.end(), [&](const ExclusionBox& b) { return b.contains(uv); });
-  };
+  const cv::Mat grey = to_grey(image);
+  const cv::Mat mask = exclusion_mask(grey.size(), exclude);
+  auto outside = [&](const cv::KeyPoint& k) { return outside_boxes(k, exclude); };
 
   Features f;
   f.norm = norm();
@@ -227,6 +252,105 @@ Features FeatureExtractor::detect(const cv::Mat& image, const std::vector<Exclus
   if (f.descriptors.empty()) {
     f.descriptors = cv::Mat(0, describer_->descriptorSize(), describer_->descriptorType());
   }
+  return f;
+}
+
+struct FeatureExtractor::Crop {
+  cv::Rect core, outer;              // the region, and the region with its context
+  std::vector<cv::KeyPoint> kps;     // in the crop's pixels, as the detector reports them
+  cv::Mat desc;                      // scale-space detectors: one row per keypoint of kps
+  std::vector<int> kept;             // indices into kps that bucketing kept
+};
+
+void FeatureExtractor::detect_crop(const cv::Mat& grey, const cv::Mat& mask, Crop& c, int candidates) const {
+  const auto det = make_detector(candidates, kOrbCropEdge);
+  const cv::Mat roi = grey(c.outer), mroi = mask.empty() ? cv::Mat() : mask(c.outer);
+  if (cfg_.kind == DetectorKind::Akaze || cfg_.kind == DetectorKind::Sift)
+    det->detectAndCompute(roi, mroi, c.kps, c.desc);
+  else
+    det->detect(roi, c.kps, mroi);
+}
+
+// Describes the kept keypoints of one crop and moves them to the frame's pixels.
+void FeatureExtractor::describe_crop(const cv::Mat& grey, Crop& c) const {
+  std::vector<cv::KeyPoint> kps;
+  for (int i : c.kept) kps.push_back(c.kps[i]);
+  cv::Mat desc;
+  if (cfg_.kind == DetectorKind::Akaze || cfg_.kind == DetectorKind::Sift) {
+    desc.create(static_cast<int>(c.kept.size()), c.desc.cols, c.desc.type());
+    for (int r = 0; r < desc.rows; ++r) c.desc.row(c.kept[r]).copyTo(desc.row(r));
+  } else {
+    const cv::Mat roi = grey(c.outer);
+    if (cfg_.kind == DetectorKind::GfttOrb)
+      for (auto& k : kps) {
+        k.size = 31;
+        k.octave = 0;
+        k.angle = intensity_centroid_angle(roi, k.pt);
+      }
+    // A crop's ORB keeps keypoints up to its own edge threshold from the crop's edge.
+    (cfg_.kind == DetectorKind::Orb ? make_detector(1, kOrbCropEdge) : describer_)->compute(roi, kps, desc);
+    if (cfg_.kind == DetectorKind::Orb) orb_keypoints_to_pixel_centres(kps, roi.size(), cfg_.orb_scale_factor);
+  }
+  for (auto& k : kps) k.pt += cv::Point2f(static_cast<float>(c.outer.x), static_cast<float>(c.outer.y));
+  c.kps = std::move(kps);
+  c.desc = desc;
+}
+
+// The whole-frame path drops ORB keypoints within its edge threshold (31 px of their pyramid level)
+// of the frame's edge; a crop's smaller edge threshold must not let them in there.
+bool FeatureExtractor::near_frame_edge(const cv::KeyPoint& k, const cv::Rect& frame) const {
+  if (cfg_.kind != DetectorKind::Orb) return false;
+  const float e = static_cast<float>(kOrbEdge * std::pow(static_cast<double>(cfg_.orb_scale_factor), k.octave));
+  return k.pt.x < e || k.pt.y < e || k.pt.x >= frame.width - e || k.pt.y >= frame.height - e;
+}
+
+Features FeatureExtractor::detect_in(const cv::Mat& image, const std::vector<cv::Rect>& regions,
+                                     const std::vector<ExclusionBox>& exclude) const {
+  const cv::Mat grey = to_grey(image);
+  const cv::Mat mask = exclusion_mask(grey.size(), exclude);
+  const cv::Rect frame(0, 0, grey.cols, grey.rows);
+  const double frame_area = static_cast<double>(frame.area());
+  const int margin = crop_margin();
+  std::vector<Crop> crops;
+  std::vector<cv::KeyPoint> all;             // candidates in the frame's pixels
+  std::vector<std::pair<int, int>> origin;   // their crop and index there
+  double core_area = 0;
+  for (const cv::Rect& r : regions) {
+    Crop c;
+    c.core = r & frame;
+    if (c.core.empty()) continue;
+    c.outer = cv::Rect(c.core.x - margin, c.core.y - margin, c.core.width + 2 * margin,
+                       c.core.height + 2 * margin) & frame;
+    core_area += c.core.area();
+    const int n = static_cast<int>(std::ceil(cfg_.max_features * cfg_.oversample * c.outer.area() / frame_area));
+    detect_crop(grey, mask, c, std::max(n, 8));
+    const cv::Point2f o(static_cast<float>(c.outer.x), static_cast<float>(c.outer.y));
+    for (int i = 0; i < static_cast<int>(c.kps.size()); ++i) {
+      cv::KeyPoint k = c.kps[i];
+      k.pt += o;
+      // Pixel (0,0)'s centre is at 0: pixel x covers [x - 0.5, x + 0.5).
+      const bool in_core = k.pt.x >= c.core.x - 0.5f && k.pt.x < c.core.br().x - 0.5f &&
+                           k.pt.y >= c.core.y - 0.5f && k.pt.y < c.core.br().y - 0.5f;
+      if (!in_core || !outside_boxes(k, exclude) || near_frame_edge(k, frame)) continue;
+      all.push_back(k);
+      origin.emplace_back(static_cast<int>(crops.size()), i);
+    }
+    crops.push_back(std::move(c));
+  }
+  const int budget = static_cast<int>(std::ceil(cfg_.max_features * std::min(1.0, core_area / frame_area)));
+  for (int i : bucket_indices(all, grey.cols, grey.rows, cfg_.grid_cols, cfg_.grid_rows, budget))
+    crops[origin[i].first].kept.push_back(origin[i].second);
+  Features f;
+  f.norm = norm();
+  std::vector<cv::Mat> rows;
+  for (auto& c : crops) {
+    if (c.kept.empty()) continue;
+    describe_crop(grey, c);
+    f.keypoints.insert(f.keypoints.end(), c.kps.begin(), c.kps.end());
+    if (!c.desc.empty()) rows.push_back(c.desc);
+  }
+  if (!rows.empty()) cv::vconcat(rows, f.descriptors);
+  else f.descriptors = cv::Mat(0, describer_->descriptorSize(), describer_->descriptorType());
   return f;
 }
 

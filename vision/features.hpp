@@ -85,9 +85,27 @@ class FeatureExtractor {
   // docs/design.md, frames and conventions (pixel (0,0) is the centre of the top-left pixel; ORB's upper pyramid levels
   // are corrected to it, orb_keypoints_to_pixel_centres).
   Features detect(const cv::Mat& image, const std::vector<ExclusionBox>& exclude = {}) const;
+  // Active search: detects and describes only inside `regions` (rectangles of the image, best
+  // disjoint). Each is cropped with crop_margin() pixels of context, enough for a keypoint inside
+  // it to be found and described at every pyramid level from the same pixels as in the whole
+  // frame. The detector's candidates and the bucketing budget are scaled to the pixels searched,
+  // so the keypoints' density matches the whole-frame path's. Cost grows with the crops' area.
+  Features detect_in(const cv::Mat& image, const std::vector<cv::Rect>& regions,
+                     const std::vector<ExclusionBox>& exclude = {}) const;
+  // Context around a region, in pixels. ORB: the 22 px its descriptor's rotated 31 px patch
+  // reaches (ceil(15 sqrt 2)), at the top pyramid level, plus one; inside a crop ORB runs with that
+  // edge threshold instead of the 31 px the whole frame keeps from its own edge.
+  int crop_margin() const;
   int norm() const;
 
  private:
+  struct Crop;
+  static constexpr int kOrbEdge = 31, kOrbCropEdge = 22;
+  cv::Ptr<cv::Feature2D> make_detector(int candidates, int orb_edge) const;
+  bool near_frame_edge(const cv::KeyPoint& k, const cv::Rect& frame) const;
+  void detect_crop(const cv::Mat& grey, const cv::Mat& mask, Crop& crop, int candidates) const;
+  void describe_crop(const cv::Mat& grey, Crop& crop) const;
+
   FeatureSettings cfg_;
   cv::Ptr<cv::Feature2D> detector_, describer_;
 };

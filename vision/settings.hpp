@@ -2,6 +2,7 @@
 // defined once by the structs of the stages that use them.
 #pragma once
 
+#include "vision/active_search.hpp"
 #include "vision/cross_match.hpp"
 #include "vision/features.hpp"
 #include "vision/tracking.hpp"
@@ -12,6 +13,7 @@ struct FrontendSettings {
   FeatureSettings features{};
   TrackingSettings tracking{};
   CrossMatchSettings cross_matching{};
+  ActiveSearchSettings active_search{};
   // Diagnostic ablation, never for reported figures: every correspondence the frontend got right
   // (ground-truth label inlier; a detected lead within the match radius) reaches the estimator at
   // its exact true projection instead of its measured pixel. Data association, wrong matches and
@@ -24,6 +26,7 @@ struct FrontendSettings {
     features.visit(v);
     v.section("tracking", [&](auto& t) { tracking.visit(t); });
     v.section("cross_matching", [&](auto& c) { cross_matching.visit(c); });
+    v.section("active_search", [&](auto& a) { active_search.visit(a); });
     v("oracle_pixels", oracle_pixels);
   }
 };

@@ -25,6 +25,13 @@ double default_tracking_distance(const cv::Mat& descriptors) {
   return default_max_descriptor_distance(descriptors);
 }
 
+Eigen::Vector2d gate_half_extent(const Eigen::Matrix2d& S, const TrackingSettings& cfg) {
+  // Bounding box of the ellipse r^T S^-1 r <= g: half-widths sqrt(g S_ii).
+  Eigen::Vector2d half(std::sqrt(cfg.gate_d2 * S(0, 0)), std::sqrt(cfg.gate_d2 * S(1, 1)));
+  if (cfg.max_search_radius_px > 0) half = half.cwiseMin(cfg.max_search_radius_px);
+  return half;
+}
+
 TrackingResult track_landmarks(const std::vector<LandmarkPrediction>& predictions,
                                const Features& frame, const DescriptorStore& store,
                                const TrackingSettings& cfg) {
@@ -56,12 +63,8 @@ TrackingResult track_landmarks(const std::vector<LandmarkPrediction>& prediction
       continue;
     }
     const Eigen::Matrix2d Sinv = llt.solve(Eigen::Matrix2d::Identity());
-    // Bounding box of the ellipse r^T S^-1 r <= g: half-widths sqrt(g S_ii).
-    double hu = std::sqrt(cfg.gate_d2 * p.S(0, 0)), hv = std::sqrt(cfg.gate_d2 * p.S(1, 1));
-    if (cfg.max_search_radius_px > 0) {
-      hu = std::min(hu, cfg.max_search_radius_px);
-      hv = std::min(hv, cfg.max_search_radius_px);
-    }
+    const Eigen::Vector2d half = gate_half_extent(p.S, cfg);
+    const double hu = half.x(), hv = half.y();
     const auto lo = std::lower_bound(us.begin(), us.end(), static_cast<float>(p.uv.x() - hu));
     const auto hi = std::upper_bound(us.begin(), us.end(), static_cast<float>(p.uv.x() + hu));
 

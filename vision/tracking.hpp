@@ -76,6 +76,10 @@ struct TrackingResult {
 // descriptor is compared with a view up to tens of seconds later; 250 for float descriptors.
 double default_tracking_distance(const cv::Mat& descriptors);
 
+// Half-widths (u, v) of the box around the gate r^T S^-1 r <= gate_d2, capped at
+// max_search_radius_px: where tracking looks for a landmark, and so where active search detects.
+Eigen::Vector2d gate_half_extent(const Eigen::Matrix2d& S, const TrackingSettings& settings);
+
 TrackingResult track_landmarks(const std::vector<LandmarkPrediction>& predictions,
                                const Features& frame, const DescriptorStore& store,
                                const TrackingSettings& settings = {});
