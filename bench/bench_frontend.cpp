@@ -1,6 +1,7 @@
 // Frontend timings on synthetic 1000 x 1000 aerial frames (the paper's camera, f = 200.1 px, at
 // 15 m and 17 m over the assets/ aerial texture laid on the ground plane, rendered exactly with a
-// homography): detect + describe per detector (1000 features, 8 x 8 bucketing), gated tracking of
+// homography): detect + describe per detector (1000 features, 8 x 8 bucketing) over the whole frame
+// and, for ORB, with active search in a typical step's regions; gated tracking of
 // 150 landmarks, cross-UAV matching of two frames' features, and the lead detector.
 //
 //   bench_frontend [--benchmark_filter=...] [--opencv_threads=N]   (default 1)
@@ -14,6 +15,7 @@
 #include <string>
 
 #include "geometry/rotation.hpp"
+#include "vision/active_search.hpp"
 #include "vision/cross_match.hpp"
 #include "vision/features.hpp"
 #include "vision/lead_detector.hpp"
@@ -174,6 +176,36 @@ void BM_OrbDetectQuarterCropped(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(n);
 }
 BENCHMARK(BM_OrbDetectQuarterCropped)->Unit(benchmark::kMillisecond);
+
+// The frontend's detect + describe with active search, in a step shaped like the paper scene's
+// (docs/studies/speed.md): 17 landmarks in view, spread over the frame, with gates of about 7 px
+// (S = 5.4 I px^2 at d^2 = 9), and 9 new landmarks wanted (3 blocks). The landmarks are frame a's
+// own whole-frame keypoints, so `tracked` says how many of them active search still finds.
+void BM_DetectDescribeActive(benchmark::State& state) {
+  const FeatureExtractor fx;
+  const Features whole = fx.detect(frame_a());
+  DescriptorStore store;
+  std::vector<LandmarkPrediction> preds;
+  for (int i = 0; i < whole.size() && preds.size() < 17; i += whole.size() / 17) {
+    store.add(i, whole.descriptors.row(i), 0);
+    preds.push_back({i, whole.pixel(i), 5.4 * Eigen::Matrix2d::Identity()});
+  }
+  const TrackingSettings tracking;
+  const ActiveSearchSettings active;
+  SearchPlan plan;
+  Features f;
+  for (auto _ : state) {
+    plan = plan_search(frame_a().size(), preds, 9, fx.crop_margin(), tracking, active);
+    f = fx.detect_in(frame_a(), plan.regions);
+    benchmark::DoNotOptimize(f.descriptors.data);
+  }
+  state.counters["fraction"] = plan.fraction;
+  state.counters["regions"] = static_cast<double>(plan.regions.size());
+  state.counters["keypoints"] = f.size();
+  state.counters["tracked"] = static_cast<double>(track_landmarks(preds, f, store, tracking).candidates.size());
+  state.counters["landmarks"] = static_cast<double>(preds.size());
+}
+BENCHMARK(BM_DetectDescribeActive)->Unit(benchmark::kMillisecond);
 
 // 150 landmarks from frame a's features (rays met with the ground), predicted exactly in frame b
 // with S = 9 I, tracked among frame b's 1000 features.

@@ -53,8 +53,12 @@ std::vector<cv::Rect> emptiest_blocks(cv::Size image, const std::vector<Landmark
   return out;
 }
 
+// A crop's fixed cost in pixels: ORB's pyramid set-up for each crop (bench_frontend's
+// BM_DetectDescribeActive: 16 crops took 12.0 ms, merged into 12 with this 10.5 ms).
+constexpr int kCropOverheadPx = 2000;
+
 // Merges boxes that overlap (a keypoint must belong to one region) and boxes whose merged crop
-// processes no more pixels than the two crops apart.
+// costs no more than the two crops apart.
 void merge_boxes(std::vector<cv::Rect>& boxes, int margin, const cv::Rect& frame) {
   auto cost = [&](const cv::Rect& r) { return (grow(r, margin) & frame).area(); };
   for (bool merged = true; merged;) {
@@ -62,7 +66,7 @@ void merge_boxes(std::vector<cv::Rect>& boxes, int margin, const cv::Rect& frame
     for (std::size_t i = 0; i < boxes.size() && !merged; ++i)
       for (std::size_t j = i + 1; j < boxes.size() && !merged; ++j) {
         const cv::Rect u = boxes[i] | boxes[j];
-        if ((boxes[i] & boxes[j]).area() > 0 || cost(u) <= cost(boxes[i]) + cost(boxes[j])) {
+        if ((boxes[i] & boxes[j]).area() > 0 || cost(u) <= cost(boxes[i]) + cost(boxes[j]) + kCropOverheadPx) {
           boxes[i] = u;
           boxes.erase(boxes.begin() + static_cast<std::ptrdiff_t>(j));
           merged = true;

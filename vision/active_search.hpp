@@ -49,7 +49,7 @@ struct SearchPlan {
 
 // Regions for one camera's frame: each prediction's gate box (gate_half_extent), plus
 // ceil(needed / landmarks_per_block) blocks for new landmarks; overlapping boxes are merged, and
-// boxes whose merged crop costs no more pixels than the two apart. `margin`: the detector's
+// boxes whose merged crop costs no more than the two apart (a crop's pixels and a fixed cost). `margin`: the detector's
 // context around a region (FeatureExtractor::crop_margin).
 SearchPlan plan_search(cv::Size image, const std::vector<LandmarkPrediction>& predictions, int needed,
                        int margin, const TrackingSettings& tracking, const ActiveSearchSettings& settings);

@@ -258,17 +258,19 @@ Features FeatureExtractor::detect(const cv::Mat& image, const std::vector<Exclus
 struct FeatureExtractor::Crop {
   cv::Rect core, outer;              // the region, and the region with its context
   std::vector<cv::KeyPoint> kps;     // in the crop's pixels, as the detector reports them
-  cv::Mat desc;                      // scale-space detectors: one row per keypoint of kps
+  cv::Mat desc;                      // one row per keypoint of kps (all but GFTT, described once kept)
   std::vector<int> kept;             // indices into kps that bucketing kept
 };
 
 void FeatureExtractor::detect_crop(const cv::Mat& grey, const cv::Mat& mask, Crop& c, int candidates) const {
   const auto det = make_detector(candidates, kOrbCropEdge);
   const cv::Mat roi = grey(c.outer), mroi = mask.empty() ? cv::Mat() : mask(c.outer);
-  if (cfg_.kind == DetectorKind::Akaze || cfg_.kind == DetectorKind::Sift)
-    det->detectAndCompute(roi, mroi, c.kps, c.desc);
-  else
+  // ORB too in one pass: describing a small crop's every candidate costs less than building its
+  // pyramid a second time for the kept ones.
+  if (cfg_.kind == DetectorKind::GfttOrb)
     det->detect(roi, c.kps, mroi);
+  else
+    det->detectAndCompute(roi, mroi, c.kps, c.desc);
 }
 
 // Describes the kept keypoints of one crop and moves them to the frame's pixels.
@@ -276,20 +278,18 @@ void FeatureExtractor::describe_crop(const cv::Mat& grey, Crop& c) const {
   std::vector<cv::KeyPoint> kps;
   for (int i : c.kept) kps.push_back(c.kps[i]);
   cv::Mat desc;
-  if (cfg_.kind == DetectorKind::Akaze || cfg_.kind == DetectorKind::Sift) {
+  if (cfg_.kind != DetectorKind::GfttOrb) {
     desc.create(static_cast<int>(c.kept.size()), c.desc.cols, c.desc.type());
     for (int r = 0; r < desc.rows; ++r) c.desc.row(c.kept[r]).copyTo(desc.row(r));
+    if (cfg_.kind == DetectorKind::Orb) orb_keypoints_to_pixel_centres(kps, c.outer.size(), cfg_.orb_scale_factor);
   } else {
     const cv::Mat roi = grey(c.outer);
-    if (cfg_.kind == DetectorKind::GfttOrb)
-      for (auto& k : kps) {
-        k.size = 31;
-        k.octave = 0;
-        k.angle = intensity_centroid_angle(roi, k.pt);
-      }
-    // A crop's ORB keeps keypoints up to its own edge threshold from the crop's edge.
-    (cfg_.kind == DetectorKind::Orb ? make_detector(1, kOrbCropEdge) : describer_)->compute(roi, kps, desc);
-    if (cfg_.kind == DetectorKind::Orb) orb_keypoints_to_pixel_centres(kps, roi.size(), cfg_.orb_scale_factor);
+    for (auto& k : kps) {
+      k.size = 31;
+      k.octave = 0;
+      k.angle = intensity_centroid_angle(roi, k.pt);
+    }
+    describer_->compute(roi, kps, desc);
   }
   for (auto& k : kps) k.pt += cv::Point2f(static_cast<float>(c.outer.x), static_cast<float>(c.outer.y));
   c.kps = std::move(kps);
@@ -314,14 +314,12 @@ Features FeatureExtractor::detect_in(const cv::Mat& image, const std::vector<cv:
   std::vector<Crop> crops;
   std::vector<cv::KeyPoint> all;             // candidates in the frame's pixels
   std::vector<std::pair<int, int>> origin;   // their crop and index there
-  double core_area = 0;
   for (const cv::Rect& r : regions) {
     Crop c;
     c.core = r & frame;
     if (c.core.empty()) continue;
     c.outer = cv::Rect(c.core.x - margin, c.core.y - margin, c.core.width + 2 * margin,
                        c.core.height + 2 * margin) & frame;
-    core_area += c.core.area();
     const int n = static_cast<int>(std::ceil(cfg_.max_features * cfg_.oversample * c.outer.area() / frame_area));
     detect_crop(grey, mask, c, std::max(n, 8));
     const cv::Point2f o(static_cast<float>(c.outer.x), static_cast<float>(c.outer.y));
@@ -337,8 +335,9 @@ Features FeatureExtractor::detect_in(const cv::Mat& image, const std::vector<cv:
     }
     crops.push_back(std::move(c));
   }
-  const int budget = static_cast<int>(std::ceil(cfg_.max_features * std::min(1.0, core_area / frame_area)));
-  for (int i : bucket_indices(all, grey.cols, grey.rows, cfg_.grid_cols, cfg_.grid_rows, budget))
+  // The whole frame's budget and grid: each cell keeps at most its share of the strongest, as
+  // there; a cell only partly searched keeps what its searched part has.
+  for (int i : bucket_indices(all, grey.cols, grey.rows, cfg_.grid_cols, cfg_.grid_rows, cfg_.max_features))
     crops[origin[i].first].kept.push_back(origin[i].second);
   Features f;
   f.norm = norm();

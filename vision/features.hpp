@@ -88,8 +88,9 @@ class FeatureExtractor {
   // Active search: detects and describes only inside `regions` (rectangles of the image, best
   // disjoint). Each is cropped with crop_margin() pixels of context, enough for a keypoint inside
   // it to be found and described at every pyramid level from the same pixels as in the whole
-  // frame. The detector's candidates and the bucketing budget are scaled to the pixels searched,
-  // so the keypoints' density matches the whole-frame path's. Cost grows with the crops' area.
+  // frame. The detector's candidates are scaled to the pixels of each crop and bucketing keeps the
+  // whole frame's share per grid cell, so the keypoints' density matches the whole-frame path's.
+  // Cost grows with the crops' area.
   Features detect_in(const cv::Mat& image, const std::vector<cv::Rect>& regions,
                      const std::vector<ExclusionBox>& exclude = {}) const;
   // Context around a region, in pixels. ORB: the 22 px its descriptor's rotated 31 px patch
