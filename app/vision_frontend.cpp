@@ -95,23 +95,79 @@ double VisionFrontend::detect(int cam, const render::Frame& frame, const slam::E
   return ms;
 }
 
+namespace {
+
+std::vector<vision::LandmarkPrediction> predictions(const slam::Estimator& est, int cam) {
+  std::vector<vision::LandmarkPrediction> out;
+  for (const auto& p : est.predictions_in_view(cam)) out.push_back({p.id, p.uv, p.S});
+  return out;
+}
+
+// The ground's height under camera `cam`: the mean of its landmarks' estimates, else the lead's.
+double ground_height(const slam::Estimator& est, const std::vector<vision::LandmarkPrediction>& preds) {
+  double sum = 0;
+  int n = 0;
+  for (const auto& p : preds)
+    if (auto x = est.landmark_position(p.id)) sum += x->z(), ++n;
+  return n > 0 ? sum / n : est.lead_position().z();
+}
+
+}  // namespace
+
+// Camera `from`'s blocks as camera `to` sees them: each block's corners and edge midpoints met
+// with the ground's plane at the estimate, projected into `to`, boxed, and grown by a margin for
+// the relief and the estimate's error (a 3 m baseline at 15 m moves a point 1 m off the plane by
+// about 3 px).
+std::vector<cv::Rect> VisionFrontend::carry_blocks(const std::vector<cv::Rect>& blocks, int from, int to,
+                                                   double ground_z, const slam::Estimator& est) const {
+  constexpr double kSlackPx = 20;
+  const Eigen::Matrix3d& R_from = est.camera(from).R_CW;
+  const Eigen::Vector3d p_from = est.camera_position(from), p_to = est.camera_position(to);
+  std::vector<cv::Rect> out;
+  for (const auto& b : blocks) {
+    double u0 = 1e9, v0 = 1e9, u1 = -1e9, v1 = -1e9;
+    int seen = 0;
+    for (int i = 0; i < 9; ++i) {
+      if (i == 4) continue;  // the centre adds nothing to the box
+      const Eigen::Vector2d uv(b.x - 0.5 + 0.5 * b.width * (i % 3), b.y - 0.5 + 0.5 * b.height * (i / 3));
+      const Eigen::Vector2d xn = cams_[from].model.unproject_normalised(uv);
+      const Eigen::Vector3d d_W = R_from.transpose() * Eigen::Vector3d(xn.x(), xn.y(), 1.0);
+      if (d_W.z() > -1e-6) continue;  // the ray never meets the ground below
+      const Eigen::Vector3d X_W = p_from + (ground_z - p_from.z()) / d_W.z() * d_W;
+      const auto q = cams_[to].model.project(est.camera(to).R_CW * (X_W - p_to));
+      if (!q) continue;
+      u0 = std::min(u0, q->x()), v0 = std::min(v0, q->y()), u1 = std::max(u1, q->x()), v1 = std::max(v1, q->y());
+      ++seen;
+    }
+    if (seen < 4) continue;
+    const int x0 = static_cast<int>(std::floor(u0 - kSlackPx)), y0 = static_cast<int>(std::floor(v0 - kSlackPx));
+    out.emplace_back(x0, y0, static_cast<int>(std::ceil(u1 + kSlackPx)) - x0 + 1,
+                     static_cast<int>(std::ceil(v1 + kSlackPx)) - y0 + 1);
+  }
+  return out;
+}
+
 // The whole frame, or with active search the gates of the landmarks the filter predicts in this
-// camera and blocks for the new landmarks the loop will ask for: target_per_camera less what is
-// in view, for the camera with the largest deficit (cooperative pairs ask for the larger of theirs).
+// camera and the blocks where the map needs new landmarks. The blocks are chosen in camera 0's
+// image and carried into the others, so that a cooperative pair finds both of its pixels; their
+// number follows the largest deficit of the cameras (a pair asks for the larger of its two).
 vision::Features VisionFrontend::detect_features(int cam, const cv::Mat& grey,
                                                  const std::vector<vision::ExclusionBox>& exclude,
                                                  const slam::Estimator& est) {
   Cam& c = cams_[cam];
   c.searched = 1.0;
-  if (!cfg_.frontend.active_search.enabled) return features_.detect(grey, exclude);
+  const auto& active = cfg_.frontend.active_search;
+  if (!active.enabled) return features_.detect(grey, exclude);
   const int target = cfg_.estimator.map.target_per_camera;
-  std::vector<vision::LandmarkPrediction> preds;
-  for (const auto& p : est.predictions_in_view(cam)) preds.push_back({p.id, p.uv, p.S});
-  int needed = target - static_cast<int>(preds.size());
+  const auto preds = predictions(est, cam);
+  const auto ref = cam == 0 ? preds : predictions(est, 0);
+  int needed = 0;
   for (int j = 0; j < num_cameras(); ++j)
-    if (j != cam) needed = std::max(needed, target - static_cast<int>(est.predictions_in_view(j).size()));
-  const auto plan = vision::plan_search(grey.size(), preds, needed, features_.crop_margin(), tracking_,
-                                        cfg_.frontend.active_search);
+    needed = std::max(needed, target - static_cast<int>(j == cam ? preds.size() : j == 0 ? ref.size()
+                                                                                        : est.predictions_in_view(j).size()));
+  auto blocks = vision::new_landmark_blocks(grey.size(), ref, needed, active);
+  if (cam != 0) blocks = carry_blocks(blocks, 0, cam, ground_height(est, ref), est);
+  const auto plan = vision::plan_search(grey.size(), preds, blocks, features_.crop_margin(), tracking_, active);
   c.searched = plan.fraction;
   return plan.whole_frame ? features_.detect(grey, exclude) : features_.detect_in(grey, plan.regions, exclude);
 }

@@ -83,6 +83,8 @@ class VisionFrontend {
   };
   vision::Features detect_features(int cam, const cv::Mat& grey, const std::vector<vision::ExclusionBox>& exclude,
                                    const slam::Estimator& est);
+  std::vector<cv::Rect> carry_blocks(const std::vector<cv::Rect>& blocks, int from, int to, double ground_z,
+                                     const slam::Estimator& est) const;
   const RunConfig& cfg_;
   vision::FeatureExtractor features_;
   vision::LeadDetector lead_;

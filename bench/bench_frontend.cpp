@@ -195,7 +195,8 @@ void BM_DetectDescribeActive(benchmark::State& state) {
   SearchPlan plan;
   Features f;
   for (auto _ : state) {
-    plan = plan_search(frame_a().size(), preds, 9, fx.crop_margin(), tracking, active);
+    plan = plan_search(frame_a().size(), preds, new_landmark_blocks(frame_a().size(), preds, 9, active),
+                       fx.crop_margin(), tracking, active);
     f = fx.detect_in(frame_a(), plan.regions);
     benchmark::DoNotOptimize(f.descriptors.data);
   }

@@ -21,15 +21,20 @@ namespace {
 
 cv::Rect grow(const cv::Rect& r, int m) { return {r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m}; }
 
-// The blocks where the predictions are fewest (then farthest from the nearest one), best first.
-std::vector<cv::Rect> emptiest_blocks(cv::Size image, const std::vector<LandmarkPrediction>& preds, int block_px,
-                                      int count) {
+}  // namespace
+
+std::vector<cv::Rect> new_landmark_blocks(cv::Size image, const std::vector<LandmarkPrediction>& preds, int needed,
+                                          const ActiveSearchSettings& settings) {
+  settings.validate();
+  if (needed <= 0) return {};
+  const int block_px = settings.block_px;
+  const int count = static_cast<int>(std::ceil(needed / settings.landmarks_per_block));
   const int cols = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.width) / block_px)));
   const int rows = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.height) / block_px)));
   struct Block {
     cv::Rect r;
     int inside = 0;
-    double nearest2 = std::numeric_limits<double>::infinity();
+    double centre2 = 0;  // squared distance of its centre from the image's
   };
   std::vector<Block> blocks;
   for (int y = 0; y < rows; ++y)
@@ -37,21 +42,22 @@ std::vector<cv::Rect> emptiest_blocks(cv::Size image, const std::vector<Landmark
       Block b;
       b.r = cv::Rect(x * image.width / cols, y * image.height / rows, (x + 1) * image.width / cols - x * image.width / cols,
                      (y + 1) * image.height / rows - y * image.height / rows);
-      const Eigen::Vector2d centre(b.r.x + 0.5 * b.r.width - 0.5, b.r.y + 0.5 * b.r.height - 0.5);
-      for (const auto& p : preds) {
+      b.centre2 = Eigen::Vector2d(b.r.x + 0.5 * b.r.width - 0.5 * image.width,
+                                  b.r.y + 0.5 * b.r.height - 0.5 * image.height).squaredNorm();
+      for (const auto& p : preds)
         if (b.r.contains(cv::Point(static_cast<int>(std::floor(p.uv.x() + 0.5)), static_cast<int>(std::floor(p.uv.y() + 0.5)))))
           ++b.inside;
-        b.nearest2 = std::min(b.nearest2, (p.uv - centre).squaredNorm());
-      }
       blocks.push_back(b);
     }
   std::stable_sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) {
-    return a.inside != b.inside ? a.inside < b.inside : a.nearest2 > b.nearest2;
+    return a.inside != b.inside ? a.inside < b.inside : a.centre2 < b.centre2;
   });
   std::vector<cv::Rect> out;
   for (int i = 0; i < std::min(count, static_cast<int>(blocks.size())); ++i) out.push_back(blocks[i].r);
   return out;
 }
+
+namespace {
 
 // A crop's fixed cost in pixels: ORB's pyramid set-up for each crop (bench_frontend's
 // BM_DetectDescribeActive: 16 crops took 12.0 ms, merged into 12 with this 10.5 ms).
@@ -77,8 +83,9 @@ void merge_boxes(std::vector<cv::Rect>& boxes, int margin, const cv::Rect& frame
 
 }  // namespace
 
-SearchPlan plan_search(cv::Size image, const std::vector<LandmarkPrediction>& predictions, int needed, int margin,
-                       const TrackingSettings& tracking, const ActiveSearchSettings& settings) {
+SearchPlan plan_search(cv::Size image, const std::vector<LandmarkPrediction>& predictions,
+                       const std::vector<cv::Rect>& blocks, int margin, const TrackingSettings& tracking,
+                       const ActiveSearchSettings& settings) {
   settings.validate();
   SearchPlan plan;
   if (!settings.enabled) return plan;
@@ -95,12 +102,11 @@ SearchPlan plan_search(cv::Size image, const std::vector<LandmarkPrediction>& pr
     boxes.push_back(r);
     ++plan.gates;
   }
-  if (needed > 0) {
-    const int count = static_cast<int>(std::ceil(needed / settings.landmarks_per_block));
-    for (const auto& b : emptiest_blocks(image, predictions, settings.block_px, count)) {
-      boxes.push_back(b);
-      ++plan.blocks;
-    }
+  for (const auto& b : blocks) {
+    const cv::Rect r = b & frame;
+    if (r.empty()) continue;
+    boxes.push_back(r);
+    ++plan.blocks;
   }
   merge_boxes(boxes, margin, frame);
   double area = 0;

@@ -17,7 +17,8 @@ namespace wingman::vision {
 struct ActiveSearchSettings {
   // Off: the whole frame every step (the reference path for comparisons).
   bool enabled = true;
-  // New landmarks come from square blocks of this side, chosen where the predictions are fewest.
+  // New landmarks come from square blocks of this side, chosen where the predictions are fewest,
+  // the most central first.
   int block_px = 125;
   // How many new landmarks one block is expected to give; ceil(needed / this) blocks are opened.
   double landmarks_per_block = 3.0;
@@ -47,11 +48,19 @@ struct SearchPlan {
   int blocks = 0;  // blocks opened for new landmarks
 };
 
-// Regions for one camera's frame: each prediction's gate box (gate_half_extent), plus
-// ceil(needed / landmarks_per_block) blocks for new landmarks; overlapping boxes are merged, and
-// boxes whose merged crop costs no more than the two apart (a crop's pixels and a fixed cost). `margin`: the detector's
-// context around a region (FeatureExtractor::crop_margin).
-SearchPlan plan_search(cv::Size image, const std::vector<LandmarkPrediction>& predictions, int needed,
-                       int margin, const TrackingSettings& tracking, const ActiveSearchSettings& settings);
+// Where `needed` new landmarks are looked for: ceil(needed / landmarks_per_block) blocks of the
+// image's block grid, those holding the fewest predictions, the most central first (a landmark near
+// the centre stays in view longest, and there a cooperative pair has the most parallax).
+std::vector<cv::Rect> new_landmark_blocks(cv::Size image, const std::vector<LandmarkPrediction>& predictions,
+                                          int needed, const ActiveSearchSettings& settings);
+
+// Regions for one camera's frame: each prediction's gate box (gate_half_extent), plus the blocks
+// for new landmarks (new_landmark_blocks, or another camera's carried into this one); overlapping
+// boxes are merged, and boxes whose merged crop costs no more than the two apart (a crop's pixels
+// and a fixed cost). `margin`: the detector's context around a region
+// (FeatureExtractor::crop_margin). Disabled, or costlier than max_fraction: the whole frame.
+SearchPlan plan_search(cv::Size image, const std::vector<LandmarkPrediction>& predictions,
+                       const std::vector<cv::Rect>& blocks, int margin, const TrackingSettings& tracking,
+                       const ActiveSearchSettings& settings);
 
 }  // namespace wingman::vision

@@ -30,12 +30,13 @@ bool covered(const std::vector<cv::Rect>& regions, const cv::Rect& box) {
 
 TEST(PlanSearch, CoversEveryGateAndOpensBlocksWhereNoLandmarkIs) {
   const cv::Size image(1000, 1000);
-  // Landmarks in the left half only: the emptiest blocks lie in the right half.
+  // Landmarks along the diagonal from the top left: the emptiest blocks nearest the centre lie off it.
   std::vector<LandmarkPrediction> preds;
   for (int i = 0; i < 10; ++i) preds.push_back(pred(i, 60 + 40 * i, 100 + 80 * i));
   const TrackingSettings tracking;
   const ActiveSearchSettings settings;  // blocks of 125 px, 3 landmarks each
-  const SearchPlan plan = plan_search(image, preds, 7, 55, tracking, settings);
+  const SearchPlan plan =
+      plan_search(image, preds, new_landmark_blocks(image, preds, 7, settings), 55, tracking, settings);
   ASSERT_FALSE(plan.whole_frame);
   EXPECT_EQ(plan.gates, 10);
   EXPECT_EQ(plan.blocks, 3);  // ceil(7 / 3)
@@ -65,7 +66,7 @@ TEST(PlanSearch, CoversEveryGateAndOpensBlocksWhereNoLandmarkIs) {
 
 TEST(PlanSearch, MergesOverlappingGatesIntoOneRegion) {
   const std::vector<LandmarkPrediction> preds{pred(1, 500, 500, 25.0), pred(2, 510, 505, 25.0)};
-  const SearchPlan plan = plan_search({1000, 1000}, preds, 0, 55, {}, {});
+  const SearchPlan plan = plan_search({1000, 1000}, preds, {}, 55, {}, {});
   ASSERT_FALSE(plan.whole_frame);
   ASSERT_EQ(plan.regions.size(), 1u);
   EXPECT_EQ(plan.blocks, 0);
@@ -77,16 +78,17 @@ TEST(PlanSearch, DetectsTheWholeFrameWhenTheCropsWouldCostMoreOrWhenSwitchedOff)
   // Fresh landmarks: gates capped at 150 px, all over the image.
   std::vector<LandmarkPrediction> preds;
   for (int i = 0; i < 9; ++i) preds.push_back(pred(i, 150 + 350 * (i % 3), 150 + 350 * (i / 3), 1e4));
-  const SearchPlan big = plan_search({1000, 1000}, preds, 0, 55, {}, {});
+  const SearchPlan big = plan_search({1000, 1000}, preds, {}, 55, {}, {});
   EXPECT_TRUE(big.whole_frame);
   EXPECT_TRUE(big.regions.empty());
   EXPECT_EQ(big.fraction, 1.0);
   ActiveSearchSettings off;
   off.enabled = false;
-  EXPECT_TRUE(plan_search({1000, 1000}, {pred(1, 500, 500)}, 0, 55, {}, off).whole_frame);
+  EXPECT_TRUE(plan_search({1000, 1000}, {pred(1, 500, 500)}, {}, 55, {}, off).whole_frame);
   ActiveSearchSettings bad;
   bad.landmarks_per_block = 0;
-  EXPECT_THROW(plan_search({1000, 1000}, {}, 1, 55, {}, bad), std::invalid_argument);
+  EXPECT_THROW(new_landmark_blocks({1000, 1000}, {}, 1, bad), std::invalid_argument);
+  EXPECT_THROW(plan_search({1000, 1000}, {}, {}, 55, {}, bad), std::invalid_argument);
 }
 
 // Inside a region, the crop's keypoints are the whole frame's at pyramid level 0: the same pixels
