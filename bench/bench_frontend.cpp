@@ -134,6 +134,17 @@ void BM_OrbDetectOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_OrbDetectOnly)->Unit(benchmark::kMillisecond);
 
+// FAST alone (threshold 12, non-maximum suppression) on level 0: what ORB's detection is made of.
+void BM_FastLevel0(benchmark::State& state) {
+  std::vector<cv::KeyPoint> kps;
+  for (auto _ : state) {
+    kps.clear();
+    cv::FAST(grey_a(), kps, FeatureSettings{}.orb_fast_threshold, true);
+  }
+  state.counters["corners"] = static_cast<double>(kps.size());
+}
+BENCHMARK(BM_FastLevel0)->Unit(benchmark::kMillisecond);
+
 void BM_OrbDescribeOnly(benchmark::State& state) {
   const auto orb = paper_orb();
   std::vector<cv::KeyPoint> all;
