@@ -26,10 +26,11 @@ std::unique_ptr<MeasurementSource> make_source(const RunConfig& cfg, const sim::
     return std::make_unique<SyntheticMeasurements>(cfg, sensors);
   // Open loop: step k+1's truth is known at step k, so its frames can render during step k.
   const bool prefetch = !cfg.closed_loop() && ro.prefetch;
-  if (prefetch) {
-    // With the prefetch, detection keeps one core busy while the frames render: llvmpipe (Mesa's
-    // software rasteriser, one thread per core by default) gets the others (docs/studies/speed.md).
-    // LP_NUM_THREADS set by the user wins; a GPU driver ignores it.
+  if (prefetch && !cfg.frontend.active_search.enabled) {
+    // With the prefetch, whole-frame detection keeps one core busy while the frames render:
+    // llvmpipe (Mesa's software rasteriser, one thread per core by default) gets the others. With
+    // active search detection takes a third of the rendering's time, and llvmpipe on every core
+    // is faster (docs/studies/speed.md). LP_NUM_THREADS set by the user wins; a GPU driver ignores it.
     const unsigned cores = std::max(2u, std::thread::hardware_concurrency());
     setenv("LP_NUM_THREADS", std::to_string(cores - 1).c_str(), /*overwrite=*/0);
   }
