@@ -103,7 +103,8 @@ std::vector<vision::LandmarkPrediction> predictions(const slam::Estimator& est, 
   return out;
 }
 
-// The ground's height under camera `cam`: the mean of its landmarks' estimates, else the lead's.
+// The ground's height under the camera these predictions are of: the mean of their landmarks' estimates,
+// else the lead's.
 double ground_height(const slam::Estimator& est, const std::vector<vision::LandmarkPrediction>& preds) {
   double sum = 0;
   int n = 0;
