@@ -57,6 +57,7 @@ void FrameMeasurements::detect_all(const slam::Estimator& est, StageTimes& st) {
 StageTimes FrameMeasurements::produce_and_detect(int k, double t, const slam::Estimator& est) {
   StageTimes st;
   const auto t_start = Clock::now();
+  frontend_.plan_step(est);  // before any camera detects, on whichever thread
   const int n = frontend_.num_cameras();
   const bool ahead = prefetch_ && k < cfg_.num_steps();
   const bool have = next_.k == k;  // produced during the previous step

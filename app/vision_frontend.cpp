@@ -87,7 +87,7 @@ double VisionFrontend::detect(int cam, const render::Frame& frame, const slam::E
   } else if (predicted) {
     exclude.push_back(predicted_lead_box(*predicted, c.model.fx(), p_est.z(), cfg_));
   }
-  c.features = detect_features(cam, grey, exclude, est);
+  c.features = detect_features(cam, grey, exclude);
   const double ms = ms_since(t0);
   c.marks = {};
   c.preds.clear();  // a camera whose landmarks are switched off tracks nothing this step
@@ -148,27 +148,35 @@ std::vector<cv::Rect> VisionFrontend::carry_blocks(const std::vector<cv::Rect>& 
   return out;
 }
 
-// The whole frame, or with active search the gates of the landmarks the filter predicts in this
-// camera and the blocks where the map needs new landmarks. The blocks are chosen in camera 0's
-// image and carried into the others, so that a cooperative pair finds both of its pixels; their
+// Every camera's predictions, and the blocks where the map needs new landmarks: chosen in camera
+// 0's image and carried into the others, so that a cooperative pair finds both of its pixels; their
 // number follows the largest deficit of the cameras (a pair asks for the larger of its two).
+void VisionFrontend::plan_step(const slam::Estimator& est) {
+  const auto& active = cfg_.frontend.active_search;
+  if (!active.enabled) return;
+  const int target = cfg_.estimator.map.target_per_camera;
+  int needed = 0;
+  for (int j = 0; j < num_cameras(); ++j) {
+    cams_[j].in_view = predictions(est, j);
+    needed = std::max(needed, target - static_cast<int>(cams_[j].in_view.size()));
+  }
+  const Cam& ref = cams_[0];
+  const auto blocks =
+      vision::new_landmark_blocks({ref.model.width(), ref.model.height()}, ref.in_view, needed, active);
+  const double ground_z = ground_height(est, ref.in_view);
+  for (int j = 0; j < num_cameras(); ++j)
+    cams_[j].blocks = j == 0 ? blocks : carry_blocks(blocks, 0, j, ground_z, est);
+}
+
+// The whole frame, or with active search the gates of the step's predictions in this camera and
+// the blocks plan_step chose for it.
 vision::Features VisionFrontend::detect_features(int cam, const cv::Mat& grey,
-                                                 const std::vector<vision::ExclusionBox>& exclude,
-                                                 const slam::Estimator& est) {
+                                                 const std::vector<vision::ExclusionBox>& exclude) {
   Cam& c = cams_[cam];
   c.searched = 1.0;
   const auto& active = cfg_.frontend.active_search;
   if (!active.enabled) return features_.detect(grey, exclude);
-  const int target = cfg_.estimator.map.target_per_camera;
-  const auto preds = predictions(est, cam);
-  const auto ref = cam == 0 ? preds : predictions(est, 0);
-  int needed = 0;
-  for (int j = 0; j < num_cameras(); ++j)
-    needed = std::max(needed, target - static_cast<int>(j == cam ? preds.size() : j == 0 ? ref.size()
-                                                                                        : est.predictions_in_view(j).size()));
-  auto blocks = vision::new_landmark_blocks(grey.size(), ref, needed, active);
-  if (cam != 0) blocks = carry_blocks(blocks, 0, cam, ground_height(est, ref), est);
-  const auto plan = vision::plan_search(grey.size(), preds, blocks, features_.crop_margin(), tracking_, active);
+  const auto plan = vision::plan_search(grey.size(), c.in_view, c.blocks, features_.crop_margin(), tracking_, active);
   c.searched = plan.fraction;
   return plan.whole_frame ? features_.detect(grey, exclude) : features_.detect_in(grey, plan.regions, exclude);
 }

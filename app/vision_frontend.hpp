@@ -50,6 +50,9 @@ class VisionFrontend {
   const geometry::PinholeCamera& model(int cam) const { return cams_[cam].model; }
   int num_cameras() const { return static_cast<int>(cams_.size()); }
 
+  // Once a step, before its detection: what active search needs from the predicted state (every
+  // camera's predictions and the blocks for new landmarks).
+  void plan_step(const slam::Estimator& est);
   // The lead, searched first around where the estimate projects it, then features outside its
   // box; returns the milliseconds spent. Cameras may detect on different threads, one at a time.
   double detect(int cam, const render::Frame& frame, const slam::Estimator& est);
@@ -80,9 +83,10 @@ class VisionFrontend {
     std::optional<Eigen::Vector2d> lead;
     Marks marks;
     double searched = 1.0;
+    std::vector<vision::LandmarkPrediction> in_view;  // plan_step's, for active search
+    std::vector<cv::Rect> blocks;                      // where new landmarks are searched
   };
-  vision::Features detect_features(int cam, const cv::Mat& grey, const std::vector<vision::ExclusionBox>& exclude,
-                                   const slam::Estimator& est);
+  vision::Features detect_features(int cam, const cv::Mat& grey, const std::vector<vision::ExclusionBox>& exclude);
   std::vector<cv::Rect> carry_blocks(const std::vector<cv::Rect>& blocks, int from, int to, double ground_z,
                                      const slam::Estimator& est) const;
   const RunConfig& cfg_;
