@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include "app/subcommand.hpp"
+#include "render/frame_cache.hpp"
 
 namespace wingman::app {
 
@@ -40,6 +41,34 @@ std::optional<double> StepLimit::seconds(double rate) const {
 
 void apply_step_limit(const StepLimit& limit, RunConfig& cfg) {
   if (const auto s = limit.seconds(cfg.rate)) limit_duration(cfg, *s);
+}
+
+FrameCacheOptions FrameCacheCli::resolve() const {
+  if (dir.empty()) return {};
+  FrameCacheOptions o;
+  try {
+    o.max_bytes = render::parse_byte_size(size);
+    if (o.max_bytes < (64ull << 20)) throw std::invalid_argument(fmt::format("'{}': at least 64M", size));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("--frame-cache-size {}", e.what()));
+  }
+  o.dir = std::filesystem::absolute(dir).string();
+  try {
+    render::FrameCache check(o.dir, o.max_bytes);  // creates it, or says why it cannot
+  } catch (const std::runtime_error& e) {
+    throw UsageError(fmt::format("--frame-cache {}", e.what()));
+  }
+  return o;
+}
+
+void add_frame_cache_options(CLI::App* cmd, FrameCacheCli& cache, const std::string& what) {
+  cmd->add_option("--frame-cache", cache.dir,
+                  "Rendered scenarios: keep every rendered frame in this directory, keyed by a hash of "
+                  "everything that decides its pixels, and read it back instead of rendering it again "
+                  "(same results; safe to share between concurrent runs; docs/frame_cache.md). " + what);
+  cmd->add_option("--frame-cache-size", cache.size,
+                  "Bound on the frame cache's size: the least recently used frames go first past it "
+                  "(e.g. 40G, 512M; default 40G)");
 }
 
 void add_force_flag(CLI::App* cmd, bool& force) {

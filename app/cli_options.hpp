@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/frame_producer.hpp"
 #include "app/run_config.hpp"
 #include "eval/results_dir.hpp"
 
@@ -33,6 +34,17 @@ struct StepLimit {
 void add_step_limit(CLI::App* cmd, StepLimit& limit);
 // Cuts the run to the limit (limit_duration).
 void apply_step_limit(const StepLimit& limit, RunConfig& cfg);
+
+// --frame-cache DIR and --frame-cache-size SIZE (render/frame_cache.hpp).
+struct FrameCacheCli {
+  std::string dir;
+  std::string size = "40G";
+  // The options for RendererFrames: dir made absolute, the size parsed (a UsageError naming
+  // --frame-cache-size when it is not a size).
+  FrameCacheOptions resolve() const;
+};
+// `what` says when the cache is used (run: only with the option; montecarlo: by default).
+void add_frame_cache_options(CLI::App* cmd, FrameCacheCli& cache, const std::string& what);
 
 // --force: replace an existing output directory of wingman's (never a foreign one).
 void add_force_flag(CLI::App* cmd, bool& force);

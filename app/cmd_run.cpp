@@ -41,6 +41,7 @@ struct RunOptions {
   bool quiet = false;
   bool print_config = false;
   StepLimit limit;
+  FrameCacheCli frame_cache;
 };
 
 int run_command(const RunOptions& o) {
@@ -51,6 +52,7 @@ int run_command(const RunOptions& o) {
     throw UsageError(e.what());
   }
   auto scenarios = select_variants(load_run_configs(o.scenario), o.variants, o.scenario);
+  const FrameCacheOptions cache = o.frame_cache.resolve();
   for (auto& s : scenarios) {
     if (o.seed) s.seed = *o.seed;
     apply_step_limit(o.limit, s);
@@ -87,6 +89,7 @@ int run_command(const RunOptions& o) {
       if (o.correspondences && scn.measurements != sim::MeasurementMode::Rendered)
         throw UsageError("--correspondences needs a scenario with measurements: rendered");
       ro.correspondences = o.correspondences;
+      ro.frame_cache = cache;
       rec = run_scenario(scn, ro,
                          [&](int k, int n) { progress.update(k, n, "steps"); });
     } catch (const std::invalid_argument& e) {
@@ -153,6 +156,7 @@ Subcommand add_run(CLI::App& parent) {
                 "correspondence offered to the filter with its true projection, label and whether "
                 "the filter accepted it (about 5 MB for the 210 s paper scene; "
                 "tools/track_error.py reads it)");
+  add_frame_cache_options(cmd, o->frame_cache, "Off unless given.");
   add_force_flag(cmd, o->force);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] { return run_command(*o); }};

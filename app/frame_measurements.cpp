@@ -172,6 +172,9 @@ void FrameMeasurements::end_step(double t) {
   video_->write(tiles, t);
 }
 
-void FrameMeasurements::finish(eval::RunRecord& rec) { rec.frontend = std::move(record_); }
+void FrameMeasurements::finish(eval::RunRecord& rec) {
+  frames_->finish(record_);
+  rec.frontend = std::move(record_);
+}
 
 }  // namespace wingman::app

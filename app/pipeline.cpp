@@ -39,7 +39,7 @@ std::unique_ptr<MeasurementSource> make_source(const RunConfig& cfg, const sim::
   fo.correspondences = ro.correspondences;
   fo.video = ro.video;
   return std::make_unique<FrameMeasurements>(cfg, truth,
-                                             std::make_unique<RendererFrames>(cfg, cfg.filter_uavs(), ro.gl, truth),
+                                             std::make_unique<RendererFrames>(cfg, cfg.filter_uavs(), ro.gl, truth, ro.frame_cache),
                                              std::make_unique<SimulatedSamples>(sensors), fo);
 }
 

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "app/frame_producer.hpp"
 #include "app/loop.hpp"
 #include "app/run_config.hpp"
 #include "eval/run_record.hpp"
@@ -30,6 +31,8 @@ struct RenderedOptions {
   bool prefetch = true;
   // Keep every tracked correspondence with its true projection (RunRecord::frontend).
   bool correspondences = false;
+  // Read frames the cache holds instead of rendering them (RendererFrames).
+  FrameCacheOptions frame_cache;
 };
 eval::RunRecord run_scenario(const RunConfig& cfg, const RenderedOptions& rendered = {},
                              const ProgressFn& progress = {}, const StateObserver& observer = {});

@@ -46,7 +46,8 @@ struct MetricSet {
 // schema version.
 MetricSet read_metric_set(const std::filesystem::path& dir);
 
-// Timings (wall_time_s, timings_ms.*, frontend.detect_busy_ms_per_step): they depend on the machine.
+// Timings (wall_time_s, timings_ms.*, frontend.detect_busy_ms_per_step, frame_cache.*): they depend
+// on the machine and on what the frame cache held.
 bool is_timing_metric(const std::string& path);
 
 // The metrics a baseline holds unless told otherwise: Table 4 totals per agent and axis, Table 5

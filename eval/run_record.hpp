@@ -96,6 +96,15 @@ struct TrackedCorrespondence {
   bool accepted = false;  // by the filter's RANSAC and gate
 };
 
+// A run's use of the frame cache (render/frame_cache.hpp); provenance and timing, not a result.
+struct FrameCacheRecord {
+  bool used = false;
+  std::string dir;
+  long hits = 0, misses = 0, corrupt = 0, stores = 0, evicted = 0;
+  double read_ms = 0, write_ms = 0;  // wall time over the run
+  double bytes_read = 0, bytes_written = 0;
+};
+
 // Rendered mode only: what the lead detector did against the truth, over every camera frame.
 struct FrontendRecord {
   bool enabled = false;
@@ -120,6 +129,7 @@ struct FrontendRecord {
   // Every tracked correspondence, when asked for (about 83 000 on the 210 s paper scene, multi-UAV).
   bool record_correspondences = false;
   std::vector<TrackedCorrespondence> correspondences;
+  FrameCacheRecord frame_cache;
 };
 
 struct PhaseInfo {

@@ -59,7 +59,8 @@ std::string csv_difference(const fs::path& a, const fs::path& b) {
 
 bool ignored_key(const std::string& k, const json& x) {
   static const std::set<std::string> keys = {"wall_time_s", "timings_ms", "software_version", "scenario_path",
-                                             "path", "real_time_factor", "renderer"};
+                                             "path", "real_time_factor", "renderer",
+                                             "frame_cache"};
   return keys.count(k) || k.ends_with("_ms") || k.ends_with("_ms_per_step") || (k == "scenario" && x.is_string());
 }
 
@@ -70,8 +71,8 @@ std::string json_difference(const json& x, const json& y, const std::string& pat
     for (const auto& [k, v] : y.items()) keys.insert(k);
     for (const auto& k : keys) {
       const std::string sub = path.empty() ? k : path + "." + k;
+      if (ignored_key(k, x.contains(k) ? x[k] : y[k])) continue;  // on one side only, too (frame_cache)
       if (!x.contains(k) || !y.contains(k)) return fmt::format("{}: only in {}", sub, x.contains(k) ? "A" : "B");
-      if (ignored_key(k, x[k])) continue;
       if (auto d = json_difference(x[k], y[k], sub); !d.empty()) return d;
     }
     return "";

@@ -4,7 +4,8 @@
 //   CSV         row by row and column by column, the timing columns (t_*_ms) left out, an
 //               empty field and "nan" both meaning no value;
 //   JSON        key by key, without wall times, timings (keys ending _ms, timings_ms,
-//               *_ms_per_step), the software version and the scenario file's path;
+//               *_ms_per_step), the software version, the scenario file's path and the
+//               frame cache's use (frame_cache: hits and misses differ, the frames do not);
 //   YAML, TUM, PLY, TXT   line by line, comment lines (#) of YAML left out (they name paths).
 // Plots, videos, logs and images are not compared (they carry timings or encoder state).
 #pragma once

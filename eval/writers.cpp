@@ -173,6 +173,12 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
                      {"accepted_error_px", stats(f.accepted_error_px)},
                      {"accepted_error_histogram",
                       {{"bin_edges_px", FrontendMetrics::kErrorBins}, {"counts", f.accepted_error_histogram}}}};
+    if (const FrameCacheRecord& c = run.frontend.frame_cache; c.used)
+      j["frame_cache"] = {{"dir", c.dir},           {"hits", c.hits},
+                          {"misses", c.misses},     {"corrupt", c.corrupt},
+                          {"stores", c.stores},     {"evicted", c.evicted},
+                          {"read_ms", num(c.read_ms)}, {"write_ms", num(c.write_ms)},
+                          {"bytes_read", num(c.bytes_read)}, {"bytes_written", num(c.bytes_written)}};
   }
   j["landmarks"] = {{"initialised", m.landmarks.initialised},
                     {"max_in_state", m.landmarks.max_in_state},

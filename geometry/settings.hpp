@@ -10,7 +10,7 @@
 // struct from YAML with file:line:key errors, the printer writes the resolved values, the
 // documentation test compares docs/scenario.md with the defaults. A visitor takes
 //   v(key, double&, Bounds)   v(key, int&, Bounds)   v(key, bool&)   v(key, std::string&)
-//   v(key, Eigen::Vector3d&)  v(key, Eigen::Vector4d&, Bounds)
+//   v(key, Eigen::Vector3d&)  v(key, Eigen::Vector4d&, Bounds)  v(key, SeedSetting&)
 //   v.choice(key, E&, {{"name", E::Value}, ...})
 //   v.section(key, [&](auto& sub) { ... })
 // Keys are YAML keys; the struct's field names may differ (the code's names stay frame- and
@@ -44,6 +44,15 @@ inline Bounds gt(double lo) { return {lo, std::numeric_limits<double>::infinity(
 inline Bounds in(double lo, double hi, bool lo_open = false, bool hi_open = false) {
   return {lo, hi, lo_open, hi_open};
 }
+
+// A seed that is a fixed number or, written `per_run`, the run's own seed.
+struct SeedSetting {
+  bool per_run = false;
+  std::uint64_t value = 1;
+  // The seed to draw from in a run of seed `run_seed`.
+  std::uint64_t resolve(std::uint64_t run_seed) const { return per_run ? run_seed : value; }
+  bool operator==(const SeedSetting&) const = default;
+};
 
 // The names an enum takes in files, in the order they are listed to a user.
 template <typename E>

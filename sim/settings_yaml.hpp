@@ -81,6 +81,9 @@ class Reader {
   void operator()(std::string_view key, geometry::Distortion& x) {
     if (auto f = get(key)) x = read_distortion(ctx_, *f);
   }
+  void operator()(std::string_view key, geometry::SeedSetting& x) {
+    if (auto f = get(key)) x = read_seed_setting(ctx_, *f);
+  }
   // A key of this map that another reader reads.
   void other(std::string_view) {}
   // A condition on values already read: fails at `key` (or at the map when the key is absent).
@@ -176,6 +179,12 @@ class Emitter {
   void put(int x) { out_ << x; }
   void put(bool x) { out_ << (x ? "true" : "false"); }
   void put(const std::string& x) { out_ << x; }
+  void put(const geometry::SeedSetting& s) {
+    if (s.per_run)
+      out_ << "per_run";
+    else
+      out_ << s.value;
+  }
   void put(const geometry::Distortion& d) { put(Eigen::Matrix<double, 5, 1>(d.k1, d.k2, d.p1, d.p2, d.k3)); }
   template <int N>
   void put(const Eigen::Matrix<double, N, 1>& v) {

@@ -25,7 +25,7 @@ TerrainModel::TerrainModel(const Scenario& scn, const OpenLoopTruth& truth)
 
   // Relief: a sum of seeded plane waves with wavelengths from relief_scale down to a quarter of
   // it, amplitudes falling with wavelength; normalised so the peak is at most `relief`.
-  auto rng = make_stream(scn.seed, "terrain");
+  auto rng = make_stream(scn.world.seed.resolve(scn.seed), "terrain");
   std::uniform_real_distribution<double> ang(0, 2 * M_PI);
   double total = 0;
   for (int i = 0; i < 8; ++i) {
@@ -93,7 +93,7 @@ std::vector<WorldObject> scatter_objects(const Scenario& scn, const TerrainModel
   const ObjectsSpec& spec = scn.world.objects;
   const Eigen::Vector4d& b = terrain.bounds();
   const double area_ha = (b(2) - b(0)) * (b(3) - b(1)) / 1e4;
-  auto rng = make_stream(scn.seed, "world_objects");
+  auto rng = make_stream(scn.world.seed.resolve(scn.seed), "world_objects");
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<WorldObject> out;
   auto place = [&](WorldObject::Type type, double per_ha) {
@@ -151,7 +151,7 @@ WorldDescription describe_world(const Scenario& scn) {
   const OpenLoopTruth truth(scn);
   TerrainModel terrain(scn, truth);
   auto objects = scatter_objects(scn, terrain);
-  return {scn.world, std::move(terrain), std::move(objects), scn.source_path, scn.seed};
+  return {scn.world, std::move(terrain), std::move(objects), scn.source_path, scn.world.seed.resolve(scn.seed)};
 }
 
 LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world) {

@@ -158,9 +158,15 @@ struct WorldSpec {
   LightSpec light{};
   ImageEffectsSpec image{};
   double near = 0.1, far = 1000;  // m, clip planes
+  // What the relief, the objects and the procedural textures are drawn from. Fixed by default, so
+  // that every run seed of a study flies over the same world (and, with a seed-free truth and no
+  // per-frame image effects, sees the same frames, which a frame cache then renders once);
+  // per_run draws a new world from each run's seed.
+  geometry::SeedSetting seed{};
 
   template <class V>
   void visit(V& v) {
+    v("seed", seed);
     v.section("terrain", [&](auto& x) { terrain.visit(x); });
     v.section("texture", [&](auto& x) { texture.visit(x); });
     v.section("objects", [&](auto& x) { objects.visit(x); });
@@ -206,7 +212,7 @@ struct WorldObject {
   std::uint32_t seed = 0;  // shape detail
 };
 
-// Objects over the terrain, reproducible from the scenario seed, clear of the lead's path.
+// Objects over the terrain, reproducible from the world seed (WorldSpec::seed), clear of the lead's path.
 std::vector<WorldObject> scatter_objects(const Scenario& scn, const TerrainModel& terrain);
 
 // The roof cue floats this far above the model's top, so it never fights with the roof for depth.

@@ -237,6 +237,14 @@ std::uint64_t read_seed(const Ctx& ctx, const Field& f) {
   return v;
 }
 
+geometry::SeedSetting read_seed_setting(const Ctx& ctx, const Field& f) {
+  const std::string s = scalar_of(ctx, f, "an integer or per_run");
+  if (s == "per_run") return {true, 1};
+  if (s.empty() || s.find_first_not_of("+-0123456789") != std::string::npos)
+    ctx.fail(f.loc(), fmt::format("expected an integer or per_run, got '{}'", s));
+  return {false, read_seed(ctx, f)};
+}
+
 bool read_bool(const Ctx& ctx, const Field& f) {
   const std::string& s = scalar_of(ctx, f, "true or false");
   if (s == "true" || s == "True" || s == "TRUE") return true;

@@ -102,6 +102,8 @@ double read_number(const Ctx& ctx, const Field& f, Bounds b = any_value());
 long long read_integer(const Ctx& ctx, const Field& f, long long lo, long long hi);
 int read_int(const Ctx& ctx, const Field& f, int lo, int hi = std::numeric_limits<int>::max());
 std::uint64_t read_seed(const Ctx& ctx, const Field& f);
+// An integer seed or `per_run`.
+geometry::SeedSetting read_seed_setting(const Ctx& ctx, const Field& f);
 bool read_bool(const Ctx& ctx, const Field& f);
 // Numbers without an upper bound of their own are at most this large in magnitude.
 inline constexpr double kMaxMagnitude = 1e9;

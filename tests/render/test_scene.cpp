@@ -124,15 +124,18 @@ TEST(Scene, RelativeAssetsResolveNextToTheScenarioFirst) {
             std::string::npos);
 }
 
-TEST(Scene, ProceduralTextureIsSeeded) {
+TEST(Scene, ProceduralTextureFollowsTheWorldSeed) {
   sim::Scenario a = paper();
   a.world.texture.type = sim::TextureSpec::Type::Procedural;
   a.world.texture.size = 256;
-  sim::Scenario b = a;
-  b.seed = a.seed + 1;
-  const Scene sa = build_scene(sim::describe_world(a)), sa2 = build_scene(sim::describe_world(a)), sb = build_scene(sim::describe_world(b));
+  sim::Scenario other_world = a, other_run = a;
+  other_world.world.seed.value = a.world.seed.value + 1;
+  other_run.seed = a.seed + 1;  // the world's seed is fixed: the same texture
+  const Scene sa = build_scene(sim::describe_world(a)), sa2 = build_scene(sim::describe_world(a)),
+              sb = build_scene(sim::describe_world(other_world)), sr = build_scene(sim::describe_world(other_run));
   EXPECT_EQ(cv::norm(sa.materials[0].texture, sa2.materials[0].texture, cv::NORM_INF), 0);
   EXPECT_GT(cv::norm(sa.materials[0].texture, sb.materials[0].texture, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(sa.materials[0].texture, sr.materials[0].texture, cv::NORM_INF), 0);
 }
 
 class PaperSceneTest : public ::testing::TestWithParam<GlBackend> {};

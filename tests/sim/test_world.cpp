@@ -3,6 +3,8 @@
 // clear of the path).
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include "sim/scenario.hpp"
 #include "sim/truth.hpp"
 #include "sim/world.hpp"
@@ -90,9 +92,9 @@ TEST(World, TerrainFollowsAGroundLeadAndIsSeeded) {
   one.duration = 0;
   const TerrainModel terrain0(one, truth);
   EXPECT_NEAR(terrain0.height(0, 0), -lead_reference_height(s.world), 1e-9);
-  // Away from the path: the seeded relief, within its amplitude.
+  // Away from the path: the relief of the world's seed, within its amplitude.
   Scenario other = s;
-  other.seed = s.seed + 1;
+  other.world.seed.value = s.world.seed.value + 1;
   const TerrainModel terrain2(other, truth);
   const Eigen::Vector4d& b = terrain.bounds();
   const double x = b(0) + 5, y = b(1) + 5;
@@ -107,6 +109,31 @@ TEST(World, TerrainFollowsAGroundLeadAndIsSeeded) {
   EXPECT_EQ(a.front().position, a2.front().position);
   for (const auto& o : a)
     EXPECT_GT(terrain.distance_to_path(o.position.x(), o.position.y()), s.world.objects.clearance);
+}
+
+TEST(World, SeedIsFixedByDefaultAndTheRunsOnlyWhenPerRun) {
+  Scenario s = parse_scenarios("name: x\nduration: 30\n", "w.yaml").front();
+  EXPECT_EQ(s.world.seed, (geometry::SeedSetting{false, 1}));
+  const auto relief_and_objects = [](const Scenario& scn) {
+    const WorldDescription w = describe_world(scn);
+    const Eigen::Vector4d& b = w.terrain.bounds();
+    return std::make_tuple(w.terrain.height(b(0) + 5, b(1) + 5), w.objects.front().position, w.seed);
+  };
+  Scenario seed7 = s;
+  seed7.seed = 7;
+  EXPECT_EQ(relief_and_objects(s), relief_and_objects(seed7));  // another run seed, the same world
+  Scenario per_run = parse_scenarios("name: x\nduration: 30\nworld: {seed: per_run}\n", "w.yaml").front();
+  EXPECT_TRUE(per_run.world.seed.per_run);
+  EXPECT_EQ(relief_and_objects(per_run), relief_and_objects(s));  // per_run with run seed 1: world 1
+  per_run.seed = 7;
+  EXPECT_NE(std::get<0>(relief_and_objects(per_run)), std::get<0>(relief_and_objects(s)));
+  EXPECT_EQ(std::get<2>(relief_and_objects(per_run)), 7u);  // and the procedural textures' seed
+  Scenario world7 = parse_scenarios("name: x\nduration: 30\nworld: {seed: 7}\n", "w.yaml").front();
+  EXPECT_EQ(relief_and_objects(world7), relief_and_objects(per_run));
+
+  EXPECT_NE(error_of("world:\n  seed: each\n").find("w.yaml:2:9: world.seed: expected an integer or per_run, got 'each'"),
+            std::string::npos) << error_of("world:\n  seed: each\n");
+  EXPECT_NE(error_of("world:\n  seed: -3\n").find("world.seed: must be >= 0"), std::string::npos);
 }
 
 }  // namespace
