@@ -118,11 +118,18 @@ std::string resume_command() {
   return cmd;
 }
 
-std::string job_list(const std::vector<Task>& tasks) {
+// The jobs with tasks not ended yet: "12", or "12 15" (as scancel takes them).
+std::string job_ids(const std::vector<Task>& tasks) {
   std::vector<std::string> ids;
   for (const Task& t : tasks)
     if (!t.ended && std::find(ids.begin(), ids.end(), t.job) == ids.end()) ids.push_back(t.job);
   return fmt::format("{}", fmt::join(ids, " "));
+}
+
+// "job 12" or "jobs 12 15".
+std::string jobs_named(const std::vector<Task>& tasks) {
+  const std::string ids = job_ids(tasks);
+  return (ids.find(' ') == std::string::npos ? "job " : "jobs ") + ids;
 }
 
 void end_task(const fs::path& out, Task& t, int exit_code, SeedOutcomes& seeds) {
@@ -143,12 +150,12 @@ void end_task(const fs::path& out, Task& t, int exit_code, SeedOutcomes& seeds) 
 void lose_task(const fs::path& out, Task& t, SeedOutcomes& seeds) {
   t.ended = t.lost = true;
   const fs::path log = task_log(out, t.job, t.index);
+  const bool logged = fs::exists(log);
   const std::string why = fmt::format(
       "Slurm task {}_{} ended without recording an exit status (cancelled, past --time, or its node "
-      "failed?): {}", t.job, t.index, fs::exists(log) ? last_line(log) : "no Slurm log");
+      "failed?): {}", t.job, t.index, logged ? last_line(log) : "no Slurm log in " + log.parent_path().string());
   seeds.failed.emplace_back(t.seed, why);
-  fmt::print(stderr, "\nrun seed {} failed ({}); Slurm's log: {}; run's log: {}\n", t.seed, why, log.string(),
-             run_log(out, t.seed).string());
+  fmt::print(stderr, "\nrun seed {} failed ({}){}\n", t.seed, why, logged ? "; Slurm's log: " + log.string() : "");
 }
 
 struct Counts {
@@ -230,10 +237,9 @@ EngineEnd follow(const SlurmStudy& s, std::vector<Task>& tasks, SeedOutcomes& se
     if (c.ended == total) break;
     if (!wait_for_next_poll(Clock::now() - start)) {
       progress.finish();
-      const std::string jobs = job_list(tasks);
-      fmt::print(stderr, "\ninterrupted: stopped following; {} of {} runs not ended yet stay on the cluster "
-                 "(Slurm job {}).\n  cancel them:           scancel {}\n  follow and aggregate:  {}\n",
-                 total - c.ended, total, jobs, jobs, resume_command());
+      fmt::print(stderr, "interrupted: stopped following; {} of {} runs not ended yet stay on the cluster "
+                 "(Slurm {}).\n  cancel them:           scancel {}\n  follow and aggregate:  {}\n",
+                 total - c.ended, total, jobs_named(tasks), job_ids(tasks), resume_command());
       return EngineEnd::interrupted;
     }
   }
@@ -257,8 +263,9 @@ void check_recorded_jobs(const fs::path& out, bool resume, bool slurm_engine) {
   std::vector<std::string> ids;
   for (const auto& j : jobs) ids.push_back(j.id);
   if (!resume)
-    throw UsageError(fmt::format("{}: Slurm job {} ran into it; pass --resume to follow it and aggregate, or "
-                                 "choose another --out", out.string(), fmt::join(ids, ", ")));
+    throw UsageError(fmt::format("{}: holds the runs of Slurm job {} ({}); pass --resume to follow and "
+                                 "aggregate them, or choose another --out", out.string(), fmt::join(ids, ", "),
+                                 (slurm_dir(out) / "jobs").string()));
   if (slurm_engine || find_on_path("squeue").empty()) return;
   for (const auto& j : jobs) {
     std::string error;
@@ -277,7 +284,7 @@ EngineEnd run_slurm(const SlurmStudy& s, const SlurmOptions& o, const std::vecto
     for (const auto& note : eval::ResultsDir::remove_stale_staging(s.out / "runs"))
       if (!s.quiet) fmt::print(stderr, "note: {}\n", note);
   if (!tasks.empty() && !s.quiet)
-    fmt::print(stderr, "following Slurm job {}: {} runs still queued or running\n", job_list(tasks), tasks.size());
+    fmt::print(stderr, "following Slurm {}: {} runs still queued or running\n", jobs_named(tasks), tasks.size());
   std::vector<std::uint64_t> rest;
   for (auto seed : pending)
     if (std::none_of(tasks.begin(), tasks.end(), [&](const Task& t) { return t.seed == seed; })) rest.push_back(seed);
@@ -286,9 +293,9 @@ EngineEnd run_slurm(const SlurmStudy& s, const SlurmOptions& o, const std::vecto
     tasks.insert(tasks.end(), added.begin(), added.end());
   }
   if (o.detach && !tasks.empty()) {
-    fmt::print("Slurm job {} runs {} of the {} seeds; this command does not wait for it.\n"
+    fmt::print("Slurm {} runs {} of the {} seeds; this command does not wait for it.\n"
                "follow it and aggregate: {}\ncancel it: scancel {}\n",
-               job_list(tasks), tasks.size(), tasks.size() + seeds.finished.size(), resume_command(), job_list(tasks));
+               jobs_named(tasks), tasks.size(), tasks.size() + seeds.finished.size(), resume_command(), job_ids(tasks));
     return EngineEnd::detached;
   }
   return tasks.empty() ? EngineEnd::done : follow(s, tasks, seeds);

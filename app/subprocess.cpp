@@ -87,9 +87,10 @@ ProcessOutput run_process(const std::vector<std::string>& args) {
   ProcessOutput result;
   drain(out, err, result);
   int st = 0;
-  while (::waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+  pid_t waited;
+  while ((waited = ::waitpid(pid, &st, 0)) < 0 && errno == EINTR) {
   }
-  result.exit_code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  result.exit_code = waited == pid && WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   return result;
 }
 
