@@ -19,6 +19,7 @@ packages=(
   libopencv-dev libopencv-contrib-dev libassimp-dev zlib1g-dev libpugixml-dev libxxhash-dev libzstd-dev
   libegl-dev libgl-dev libosmesa6-dev libegl-mesa0 libgl1-mesa-dri
   gnuplot-nox python3 python3-yaml
+  slurm-wlm munge
 )
 
 install_packages() {
