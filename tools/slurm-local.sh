@@ -99,6 +99,7 @@ JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
 JobCompType=jobcomp/none
 MpiDefault=none
+MailProg=/bin/true  # none installed; slurmctld logs an error at every start without one
 SwitchType=switch/none
 SchedulerType=sched/backfill
 SelectType=select/cons_tres
@@ -114,6 +115,11 @@ EOF
 start_munged() {
   # munged wants its key private and every directory above its socket searchable by all; --force
   # lets it run under a private one (mkdtemp's 0700): only root, which passes anyway, uses it here.
+  # --force would also take the socket over from a live munged: refuse that one instead.
+  if munge -n -S "$dir/munge/munge.socket.2" >/dev/null 2>&1; then
+    echo "slurm-local: a munged this script did not start serves $dir/munge/munge.socket.2; stop it first" >&2
+    exit 2
+  fi
   mkdir -p "$dir/munge"
   chmod 0755 "$dir/munge"
   if [ ! -s "$dir/munge/munge.key" ]; then
