@@ -43,16 +43,19 @@ void apply_step_limit(const StepLimit& limit, RunConfig& cfg) {
   if (const auto s = limit.seconds(cfg.rate)) limit_duration(cfg, *s);
 }
 
-FrameCacheOptions FrameCacheCli::resolve() const {
-  if (dir.empty()) return {};
-  FrameCacheOptions o;
+std::uint64_t FrameCacheCli::max_bytes() const {
   try {
-    o.max_bytes = render::parse_byte_size(size);
-    if (o.max_bytes < (64ull << 20)) throw std::invalid_argument(fmt::format("'{}': at least 64M", size));
+    const std::uint64_t bytes = render::parse_byte_size(size);
+    if (bytes < (64ull << 20)) throw std::invalid_argument(fmt::format("'{}': at least 64M", size));
+    return bytes;
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("--frame-cache-size {}", e.what()));
   }
-  o.dir = std::filesystem::absolute(dir).string();
+}
+
+FrameCacheOptions FrameCacheCli::resolve() const {
+  if (dir.empty()) return {};
+  FrameCacheOptions o{std::filesystem::absolute(dir).string(), max_bytes()};
   try {
     render::FrameCache check(o.dir, o.max_bytes);  // creates it, or says why it cannot
   } catch (const std::runtime_error& e) {

@@ -39,8 +39,10 @@ void apply_step_limit(const StepLimit& limit, RunConfig& cfg);
 struct FrameCacheCli {
   std::string dir;
   std::string size = "40G";
-  // The options for RendererFrames: dir made absolute, the size parsed (a UsageError naming
-  // --frame-cache-size when it is not a size).
+  // The size bound; a UsageError naming --frame-cache-size when it is not a size of 64M or more.
+  std::uint64_t max_bytes() const;
+  // The options for RendererFrames: dir made absolute and created (a UsageError naming
+  // --frame-cache when it cannot be), the size checked.
   FrameCacheOptions resolve() const;
 };
 // `what` says when the cache is used (run: only with the option; montecarlo: by default).

@@ -51,6 +51,8 @@ struct MonteCarloOptions {
   bool quiet = false;
   std::string engine = "local";
   SlurmOptions slurm;
+  FrameCacheCli frame_cache;
+  bool no_frame_cache = false;
   std::vector<std::string> given;  // the options given on the command line, for the engine checks
 };
 
@@ -76,6 +78,9 @@ void check_engine(const MonteCarloOptions& o) {
   if (slurm && given(o, "--array-limit") && o.slurm.array_limit < 1)
     throw UsageError(fmt::format("--array-limit {}: must be at least 1", o.slurm.array_limit));
   if (slurm) check_slurm_clients();
+  if (o.no_frame_cache && (given(o, "--frame-cache") || given(o, "--frame-cache-size")))
+    throw UsageError("--no-frame-cache with --frame-cache or --frame-cache-size: choose one");
+  o.frame_cache.max_bytes();  // a bad size fails before the study opens
 }
 
 // Variant directories of one run: <run>/<variant> when the scenario has variants.
@@ -185,17 +190,45 @@ int aggregate(const MonteCarloOptions& o, const fs::path& out, const std::vector
   return seeds.failed.empty() ? 0 : 1;
 }
 
+// The study's frame cache: --frame-cache, else <out>/frame_cache, for rendered scenarios unless
+// --no-frame-cache; absolute, for workers and cluster nodes that start elsewhere.
+FrameCacheOptions frame_cache_of(const MonteCarloOptions& o, const fs::path& out, const std::vector<RunConfig>& scenarios) {
+  const bool rendered = std::any_of(scenarios.begin(), scenarios.end(), [](const RunConfig& s) {
+    return s.measurements == sim::MeasurementMode::Rendered;
+  });
+  if (o.no_frame_cache || !rendered) return {};
+  FrameCacheCli cli = o.frame_cache;
+  if (cli.dir.empty()) cli.dir = (fs::absolute(out) / "frame_cache").string();
+  return cli.resolve();
+}
+
+bool cache_is_empty(const std::string& dir) {
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+    if (it->path().extension() == ".frame") return false;
+  return true;
+}
+
 // The pending seeds through the chosen engine; both leave the same finished and failed lists.
 EngineEnd run_engine(const MonteCarloOptions& o, const fs::path& out, const std::vector<RunConfig>& scenarios,
                      const std::vector<std::uint64_t>& pending, SeedOutcomes& seeds) {
-  const RunSpec spec{o.scenario, o.variants, o.limit};
+  RunSpec spec{o.scenario, o.variants, o.limit, frame_cache_of(o, out, scenarios)};
   if (o.engine == "slurm") {
     SlurmStudy study{spec, fs::absolute(out), scenarios.front().name, o.quiet};
     study.spec.scenario = fs::absolute(o.scenario).string();  // the tasks may start elsewhere
     return run_slurm(study, o.slurm, pending, seeds);
   }
   const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
-  const EngineEnd end = run_local(spec, out, pending, jobs, o.quiet, seeds);
+  EngineEnd end = EngineEnd::done;
+  std::size_t first = 0;
+  if (!spec.frame_cache.dir.empty() && jobs > 1 && pending.size() > 1 && cache_is_empty(spec.frame_cache.dir)) {
+    // An empty cache: the first run alone renders every frame once (the renderer takes every core)
+    // rather than each of `jobs` workers rendering them side by side.
+    end = run_local(spec, out, {pending.front()}, 1, o.quiet, seeds);
+    first = 1;
+  }
+  if (end == EngineEnd::done)
+    end = run_local(spec, out, {pending.begin() + static_cast<std::ptrdiff_t>(first), pending.end()}, jobs, o.quiet, seeds);
   if (end == EngineEnd::interrupted)
     fmt::print(stderr, "interrupted: {} of {} runs finished and kept in {}; rerun with --resume to "
                "run the rest\n", seeds.finished.size(), o.runs, out.string());
@@ -253,6 +286,8 @@ Subcommand add_montecarlo(CLI::App& parent) {
                 "queued or running, and submit the seeds neither finished nor queued)");
   cmd->add_flag("--no-plots", o->no_plots, "Skip the NEES plot (no gnuplot needed)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
+  add_frame_cache_options(cmd, o->frame_cache, "By default <out>/frame_cache for rendered scenarios.");
+  cmd->add_flag("--no-frame-cache", o->no_frame_cache, "Render every run's frames (no frame cache)");
   cmd->add_option("--engine", o->engine,
                   "Where the runs go: local (worker processes on this machine, the default) or slurm (one "
                   "Slurm array job, a task per seed; --out must be on a filesystem the compute nodes share)");

@@ -14,6 +14,9 @@ std::vector<std::string> run_arguments(const RunSpec& spec, const std::string& s
   for (const auto& v : spec.variants) args.insert(args.end(), {"--variant", v});
   if (spec.limit.duration) args.insert(args.end(), {"--duration", fmt::format("{}", *spec.limit.duration)});
   if (spec.limit.frames) args.insert(args.end(), {"--frames", std::to_string(*spec.limit.frames)});
+  if (!spec.frame_cache.dir.empty())
+    args.insert(args.end(), {"--frame-cache", spec.frame_cache.dir, "--frame-cache-size",
+                             std::to_string(spec.frame_cache.max_bytes)});
   return args;
 }
 

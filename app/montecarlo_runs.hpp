@@ -18,6 +18,7 @@ struct RunSpec {
   std::string scenario;
   std::vector<std::string> variants;
   StepLimit limit;
+  FrameCacheOptions frame_cache;  // one directory every run of the study shares
 };
 
 // `wingman run`'s arguments (after argv[0]) for one seed, written into run_dir(out, seed). Both

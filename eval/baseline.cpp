@@ -83,8 +83,9 @@ const char* better_name(Better b) {
 }
 
 Baseline make_baseline(const MetricSet& set, const BaselineOptions& o) {
-  const std::optional<Rule> relative_rule =
-      o.rule.empty() ? std::nullopt : std::optional<Rule>(chosen_rule(o.rule, set.monte_carlo));
+  // A plain flag and value (not std::optional): GCC 12 warns falsely of an uninitialised optional.
+  const bool override_rule = !o.rule.empty();
+  const Rule relative_rule = override_rule ? chosen_rule(o.rule, set.monte_carlo) : Rule::kRel;
   Baseline b;
   b.metrics_schema = kMetricsSchemaVersion;
   b.kind = set.monte_carlo ? "montecarlo" : "results";
@@ -104,7 +105,7 @@ Baseline make_baseline(const MetricSet& set, const BaselineOptions& o) {
     e.metric = metric;
     e.reference = s.mean;
     const bool relative = d.rule == Rule::kRel || d.rule == Rule::kMean || d.rule == Rule::kPaired;
-    e.rule = relative && !d.warn_only && relative_rule ? *relative_rule : d.rule;
+    e.rule = relative && !d.warn_only && override_rule ? relative_rule : d.rule;
     e.better = d.better;
     e.warn_only = d.warn_only;
     e.tolerance = d.tolerance;

@@ -85,6 +85,38 @@ TEST(FrameCacheCli, CachedRunsGiveTheUncachedResults) {
   EXPECT_EQ(frame_cache_of(tmp / "damaged")["stores"], 1);
 }
 
+TEST(FrameCacheCli, MonteCarloSharesOneCacheAndGivesTheUncachedStudy) {
+  try {
+    wingman::render::create_gl_context(wingman::render::GlBackend::Auto);
+  } catch (const wingman::render::GlContextError& e) {
+    WINGMAN_NO_GL_CONTEXT(e.what());
+  }
+  TempDir tmp;
+  auto study = [&](const std::string& out, const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"montecarlo", kRenderedSmoke.string(), "--runs", "3", "--jobs", "2",
+                                     "--frames", "6", "--out", (tmp / out).string(), "--no-plots", "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_wingman(args, tmp.path());
+  };
+  ASSERT_EQ(study("plain", {"--no-frame-cache"}).exit_code, 0);
+  const RunResult cached = study("cached", {});
+  ASSERT_EQ(cached.exit_code, 0) << cached.output;
+  expect_same_results(tmp, "plain", "cached");
+  EXPECT_FALSE(fs::exists(tmp / "plain" / "frame_cache"));
+  // The first seed rendered alone into <out>/frame_cache; every later run and variant read it.
+  const fs::path runs = tmp / "cached" / "runs";
+  EXPECT_EQ(frame_cache_of(runs / "seed1")["misses"], 10);  // steps 1-5, two cameras
+  EXPECT_EQ(frame_cache_of(runs / "seed1", "single")["hits"], 5);
+  for (const char* seed : {"seed2", "seed3"}) {
+    EXPECT_EQ(frame_cache_of(runs / seed)["hits"], 10) << seed;
+    EXPECT_EQ(frame_cache_of(runs / seed)["misses"], 0) << seed;
+  }
+  EXPECT_EQ(frame_cache_of(runs / "seed1")["dir"], (tmp / "cached" / "frame_cache").string());
+  const RunResult both = study("x", {"--no-frame-cache", "--frame-cache", (tmp / "c").string()});
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  EXPECT_FALSE(fs::exists(tmp / "x"));
+}
+
 TEST(FrameCacheCli, BadCacheOptionsAreUsageErrors) {
   TempDir tmp;
   write_file(tmp / "a_file", "not a directory");

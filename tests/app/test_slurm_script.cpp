@@ -15,7 +15,7 @@ using ::testing::Not;
 
 TEST(SlurmScript, RunsTheLocalWorkersCommandWithTheSeedFromItsTask) {
   const ArrayJob job{"/shared/mc", 2, {5, 6, 9}, "wingman-smoke", "/opt/bin/wingman", "/home/me"};
-  RunSpec spec{"/home/me/scenes/it's.yaml", {"multi"}, {}};
+  RunSpec spec{"/home/me/scenes/it's.yaml", {"multi"}, {}, {}};
   spec.limit.frames = 40;
   const SlurmOptions options{"gpu", "1:00:00", "2G", 2, false};
   const std::string s = array_script(job, spec, options);

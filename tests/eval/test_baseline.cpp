@@ -104,7 +104,9 @@ TEST(Baseline, YamlReadsBackExactly) {
   // Timings warn, errors fail; fractions are absolute.
   for (const auto& e : back.entries) {
     EXPECT_EQ(e.warn_only, is_timing_metric(e.metric)) << e.metric;
-    if (e.metric.ends_with("_fraction")) EXPECT_EQ(e.rule, Rule::kAbs) << e.metric;
+    if (e.metric.ends_with("_fraction")) {
+      EXPECT_EQ(e.rule, Rule::kAbs) << e.metric;
+    }
   }
   const CheckReport r = check_against_baseline(set, back);
   EXPECT_EQ(r.failed, 0);
@@ -114,7 +116,7 @@ TEST(Baseline, YamlReadsBackExactly) {
 TEST(Baseline, ToleranceOptionsReplaceTheDefaults) {
   TempDir tmp;
   const MetricSet set = read_metric_set(write_run(tmp.path() / "res"));
-  const Baseline b = make_baseline(set, {{}, 0.05, 0.001});
+  const Baseline b = make_baseline(set, {{}, 0.05, 0.001, ""});
   for (const auto& e : b.entries) {
     if (e.warn_only) continue;
     EXPECT_EQ(e.tolerance, e.rule == Rule::kAbs ? 0.001 : 0.05) << e.metric;
@@ -257,7 +259,7 @@ TEST(MetricSet, MonteCarloDirectoryGivesOneValuePerSeedAndItsFailedSeedsFail) {
   ASSERT_EQ(set.failures.size(), 1u);
   EXPECT_NE(set.failures[0].find("seed 3: exit 1"), std::string::npos) << set.failures[0];
 
-  const Baseline b = make_baseline(set, {{"table4.total.lead.mse.x"}, -1, -1});
+  const Baseline b = make_baseline(set, {{"table4.total.lead.mse.x"}, -1, -1, ""});
   ASSERT_EQ(b.entries.size(), 1u);
   EXPECT_EQ(b.entries[0].rule, Rule::kPaired);
   EXPECT_EQ(b.entries[0].per_seed.size(), 2u);
@@ -280,7 +282,7 @@ TEST(Baseline, AMetricWithoutAValueIsLeftOutAndNamed) {
   set.paths = {"nees.mean", "table4.total.lead.mse.x"};
   set.values = {{"nees.mean", {kNaN}}, {"table4.total.lead.mse.x", {0.25}}};
   set.seeds = {1};
-  const Baseline b = make_baseline(set, {{"*"}, -1, -1});
+  const Baseline b = make_baseline(set, {{"*"}, -1, -1, ""});
   ASSERT_EQ(b.entries.size(), 1u);
   EXPECT_EQ(b.entries[0].metric, "table4.total.lead.mse.x");
   EXPECT_EQ(b.left_out, std::vector<std::string>{"nees.mean"});
