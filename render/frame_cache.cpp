@@ -3,6 +3,7 @@
 #include "render/source_hash.hpp"  // generated: cmake/source_hash.cmake
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <xxhash.h>
 #include <zstd.h>
@@ -88,35 +89,62 @@ bool zstd_decompress(const std::uint8_t* in, std::size_t n, void* out, std::size
   return !ZSTD_isError(r) && r == expect;
 }
 
-bool read_whole(const fs::path& p, std::vector<std::uint8_t>& buf) {
-  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(p.c_str(), "rb"), &std::fclose);
-  if (!f) return false;
-  if (std::fseek(f.get(), 0, SEEK_END) != 0) return false;
-  const long size = std::ftell(f.get());
-  if (size < 0 || std::fseek(f.get(), 0, SEEK_SET) != 0) return false;
-  buf.resize(static_cast<std::size_t>(size));
-  return std::fread(buf.data(), 1, buf.size(), f.get()) == buf.size();
-}
-
-// The entry's pixels from its payload, or an empty frame when they do not decode.
-Frame decode(const Header& h, const std::uint8_t* payload) {
+// A zstd entry's pixels from its payload, or an empty frame when they do not decode.
+Frame decode_zstd(const Header& h, const std::uint8_t* payload) {
   Frame f;
   f.rgb.create(h.height, h.width, CV_8UC3);
   f.depth.create(h.height, h.width, CV_32FC1);
   const std::size_t rgb_n = f.rgb.total() * 3, depth_n = f.depth.total() * 4;
-  if (h.codec == static_cast<std::uint32_t>(FrameCodec::Raw)) {
-    if (h.rgb_bytes != rgb_n || h.depth_bytes != depth_n) return {};
-    std::memcpy(f.rgb.data, payload, rgb_n);
-    std::memcpy(f.depth.data, payload + rgb_n, depth_n);
-    return f;
-  }
-  if (h.codec != static_cast<std::uint32_t>(FrameCodec::Zstd)) return {};
   std::vector<std::uint8_t> shuffled(depth_n);
   if (!zstd_decompress(payload, h.rgb_bytes, f.rgb.data, rgb_n) ||
       !zstd_decompress(payload + h.rgb_bytes, h.depth_bytes, shuffled.data(), depth_n))
     return {};
   unshuffle4(shuffled.data(), f.depth.data, f.depth.total());
   return f;
+}
+
+std::uint64_t payload_hash(const void* a, std::size_t na, const void* b, std::size_t nb) {
+  XXH3_state_t* st = XXH3_createState();
+  XXH3_64bits_reset(st);
+  XXH3_64bits_update(st, a, na);
+  XXH3_64bits_update(st, b, nb);
+  const std::uint64_t h = XXH3_64bits_digest(st);
+  XXH3_freeState(st);
+  return h;
+}
+
+constexpr const char* kMissing = "missing";
+
+// Reads the entry at `path` into `f` (raw pixels straight into the frame's buffers): nullptr when
+// it is whole, kMissing when there is none, else what is wrong with it.
+const char* read_entry(const fs::path& path, const FrameKey& key, Frame& f, std::uint64_t& bytes) {
+  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!file) return kMissing;
+  struct stat st {};
+  if (::fstat(::fileno(file.get()), &st) != 0) return kMissing;
+  bytes = static_cast<std::uint64_t>(st.st_size);
+  Header h;
+  if (bytes < sizeof h || std::fread(&h, sizeof h, 1, file.get()) != 1) return "shorter than its header";
+  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 || h.header_hash != header_hash(h)) return "bad header";
+  if (h.key_hi != key.hi || h.key_lo != key.lo) return "holds another key";
+  const std::uint64_t pixels = static_cast<std::uint64_t>(h.width) * static_cast<std::uint64_t>(h.height);
+  if (h.width <= 0 || h.height <= 0 || bytes != sizeof h + h.rgb_bytes + h.depth_bytes) return "wrong size";
+  if (h.codec == static_cast<std::uint32_t>(FrameCodec::Raw)) {
+    if (h.rgb_bytes != 3 * pixels || h.depth_bytes != 4 * pixels) return "wrong size";
+    f.rgb.create(h.height, h.width, CV_8UC3);
+    f.depth.create(h.height, h.width, CV_32FC1);
+    if (std::fread(f.rgb.data, 1, h.rgb_bytes, file.get()) != h.rgb_bytes ||
+        std::fread(f.depth.data, 1, h.depth_bytes, file.get()) != h.depth_bytes)
+      return "wrong size";
+    if (payload_hash(f.rgb.data, h.rgb_bytes, f.depth.data, h.depth_bytes) != h.payload_hash) return "checksum mismatch";
+    return nullptr;
+  }
+  if (h.codec != static_cast<std::uint32_t>(FrameCodec::Zstd)) return "unknown codec";
+  std::vector<std::uint8_t> payload(h.rgb_bytes + h.depth_bytes);
+  if (std::fread(payload.data(), 1, payload.size(), file.get()) != payload.size()) return "wrong size";
+  if (XXH3_64bits(payload.data(), payload.size()) != h.payload_hash) return "checksum mismatch";
+  f = decode_zstd(h, payload.data());
+  return f.rgb.empty() ? "pixels do not decode" : nullptr;
 }
 
 }  // namespace
@@ -193,9 +221,11 @@ void FrameCache::warn(const std::string& what) const {
 std::optional<Frame> FrameCache::load(const FrameKey& key) {
   const auto t0 = Clock::now();
   const fs::path path = entry_path(key);
-  std::vector<std::uint8_t> buf;
-  auto miss = [&](const char* why) -> std::optional<Frame> {
-    if (why) {
+  Frame f;
+  std::uint64_t bytes = 0;
+  const char* why = read_entry(path, key, f, bytes);
+  if (why) {
+    if (why != kMissing) {
       ++stats_.corrupt;
       warn(fmt::format("{}: damaged frame cache entry ({}); removed, the frame is rendered again", path.string(), why));
       std::error_code ec;
@@ -204,24 +234,11 @@ std::optional<Frame> FrameCache::load(const FrameKey& key) {
     ++stats_.misses;
     stats_.read_ms += ms_since(t0);
     return std::nullopt;
-  };
-  if (!read_whole(path, buf)) return miss(nullptr);
-  Header h;
-  if (buf.size() < sizeof h) return miss("shorter than its header");
-  std::memcpy(&h, buf.data(), sizeof h);
-  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 || h.header_hash != header_hash(h))
-    return miss("bad header");
-  if (h.key_hi != key.hi || h.key_lo != key.lo) return miss("holds another key");
-  if (h.width <= 0 || h.height <= 0 || buf.size() != sizeof h + h.rgb_bytes + h.depth_bytes)
-    return miss("wrong size");
-  const std::uint8_t* payload = buf.data() + sizeof h;
-  if (XXH3_64bits(payload, h.rgb_bytes + h.depth_bytes) != h.payload_hash) return miss("checksum mismatch");
-  Frame f = decode(h, payload);
-  if (f.rgb.empty()) return miss("pixels do not decode");
+  }
   std::error_code ec;
   fs::last_write_time(path, fs::file_time_type::clock::now(), ec);  // recently used: evicted last
   ++stats_.hits;
-  stats_.bytes_read += buf.size();
+  stats_.bytes_read += bytes;
   stats_.read_ms += ms_since(t0);
   return f;
 }
@@ -250,12 +267,7 @@ void FrameCache::store(const FrameKey& key, const Frame& frame) {
   h.width = rgb.cols, h.height = rgb.rows;
   h.codec = static_cast<std::uint32_t>(codec_);
   h.rgb_bytes = rgb_s, h.depth_bytes = depth_s;
-  XXH3_state_t* st = XXH3_createState();
-  XXH3_64bits_reset(st);
-  XXH3_64bits_update(st, rgb_p, rgb_s);
-  XXH3_64bits_update(st, depth_p, depth_s);
-  h.payload_hash = XXH3_64bits_digest(st);
-  XXH3_freeState(st);
+  h.payload_hash = payload_hash(rgb_p, rgb_s, depth_p, depth_s);
   h.header_hash = header_hash(h);
 
   const fs::path path = entry_path(key);

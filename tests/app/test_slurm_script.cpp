@@ -32,6 +32,11 @@ TEST(SlurmScript, RunsTheLocalWorkersCommandWithTheSeedFromItsTask) {
   EXPECT_THAT(s, HasSubstr("status='/shared/mc/slurm/status/seed'\"$seed\"\n"));
   EXPECT_THAT(s, HasSubstr("mv -f \"$status.tmp.$SLURM_JOB_ID\" \"$status\""));
   EXPECT_THAT(s, Not(HasSubstr("\x1f")));
+  // A rendered study's tasks share its frame cache, under the shared output directory.
+  RunSpec cached = spec;
+  cached.frame_cache = {"/shared/mc/frame_cache", 1ull << 30};
+  EXPECT_THAT(array_script(job, cached, options),
+              HasSubstr("'--frames' '40' '--frame-cache' '/shared/mc/frame_cache' '--frame-cache-size' '1073741824' >"));
   // Options left out are the cluster's defaults.
   EXPECT_THAT(array_script(job, spec, {}), Not(HasSubstr("--partition")));
   EXPECT_THAT(array_script(job, spec, {}), HasSubstr("#SBATCH --array=0-2\n"));
