@@ -34,6 +34,16 @@ RunResult run_smoke(const TempDir& tmp, const std::string& out, const std::strin
   return run_wingman(args, tmp.path());
 }
 
+// Why no OpenGL context can be made here, or "" when one can.
+std::string no_gl_context() {
+  try {
+    wingman::render::create_gl_context(wingman::render::GlBackend::Auto);
+    return "";
+  } catch (const wingman::render::GlContextError& e) {
+    return e.what();
+  }
+}
+
 void expect_same_results(const TempDir& tmp, const std::string& a, const std::string& b) {
   const RunResult r = run_wingman({"check", (tmp / a).string(), "--against", (tmp / b).string()}, tmp.path());
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -41,11 +51,7 @@ void expect_same_results(const TempDir& tmp, const std::string& a, const std::st
 }
 
 TEST(FrameCacheCli, CachedRunsGiveTheUncachedResults) {
-  try {
-    wingman::render::create_gl_context(wingman::render::GlBackend::Auto);
-  } catch (const wingman::render::GlContextError& e) {
-    WINGMAN_NO_GL_CONTEXT(e.what());
-  }
+  if (const std::string why = no_gl_context(); !why.empty()) WINGMAN_NO_GL_CONTEXT(why);
   TempDir tmp;
   const std::string cache = (tmp / "cache").string();
   ASSERT_EQ(run_smoke(tmp, "plain", "multi").exit_code, 0);
@@ -86,11 +92,7 @@ TEST(FrameCacheCli, CachedRunsGiveTheUncachedResults) {
 }
 
 TEST(FrameCacheCli, MonteCarloSharesOneCacheAndGivesTheUncachedStudy) {
-  try {
-    wingman::render::create_gl_context(wingman::render::GlBackend::Auto);
-  } catch (const wingman::render::GlContextError& e) {
-    WINGMAN_NO_GL_CONTEXT(e.what());
-  }
+  if (const std::string why = no_gl_context(); !why.empty()) WINGMAN_NO_GL_CONTEXT(why);
   TempDir tmp;
   auto study = [&](const std::string& out, const std::vector<std::string>& extra) {
     std::vector<std::string> args = {"montecarlo", kRenderedSmoke.string(), "--runs", "3", "--jobs", "2",
