@@ -13,6 +13,7 @@
 #include "app/timing.hpp"
 #include "app/version.hpp"
 #include "sim/rng.hpp"
+#include "sim/world.hpp"
 #include "slam/health.hpp"
 
 namespace wingman::app {
@@ -295,8 +296,11 @@ void Run::record_step(int k, double t, const StepCounts& n, const StepTimes& tm)
   st.phase = cfg_.phase_at(t);
   const auto& s = est.state();
   Eigen::VectorXd x_true(s.kinematic_dim());
-  auto agent = [&](const sim::KinematicState& tr, int pos) {
+  auto agent = [&](const sim::KinematicState& tr, int pos, const Eigen::Quaterniond& q_true,
+                   const Eigen::Quaterniond& q_est) {
     eval::AgentStep a;
+    a.q_true = q_true;
+    a.q_est = q_est;
     a.p_true = tr.position;
     a.v_true = tr.velocity;
     a.p_est = s.x.segment<3>(pos);
@@ -310,8 +314,14 @@ void Run::record_step(int k, double t, const StepCounts& n, const StepTimes& tm)
     x_true.segment<3>(pos + 3) = tr.velocity;
     st.agents.push_back(a);
   };
-  agent(truth_.lead(t), slam::FilterState::lead_pos());
-  for (int j = 0; j < cameras(); ++j) agent(truth_.camera(cam_uav_[j], t), slam::FilterState::cam_pos(j));
+  const auto about_z = [](double yaw) { return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())); };
+  const Eigen::Vector3d v_lead = s.x.segment<3>(slam::FilterState::lead_pos() + 3);
+  agent(truth_.lead(t), slam::FilterState::lead_pos(), about_z(sim::lead_heading(truth_, t)),
+        about_z(std::atan2(v_lead.y(), v_lead.x())));
+  const Eigen::Quaterniond q_commanded(Eigen::Matrix3d(truth_.commanded_R_CW().transpose()));
+  for (int j = 0; j < cameras(); ++j)
+    agent(truth_.camera(cam_uav_[j], t), slam::FilterState::cam_pos(j),
+          Eigen::Quaterniond(Eigen::Matrix3d(truth_.camera_R_CW(cam_uav_[j], t).transpose())), q_commanded);
   st.nees = k == 0 ? eval::kNaN : agent_nees(s, x_true);
   st.nees_dof = s.kinematic_dim();
   st.landmarks = est.num_landmarks();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -17,6 +18,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 struct AgentStep {
   Eigen::Vector3d p_true = Eigen::Vector3d::Zero(), v_true = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_est = Eigen::Vector3d::Zero(), v_est = Eigen::Vector3d::Zero();
+  // Orientation of the agent's frame in the world (q_WB), for the TUM files: the lead's heading
+  // about z; a UAV's camera attitude (its state is the camera's position). "true" from the truth
+  // (the lead's direction of travel; the camera's attitude with the gimbal error), "est" what the
+  // run had (the heading of the estimated velocity; the commanded attitude the filter is given).
+  Eigen::Quaterniond q_true = Eigen::Quaterniond::Identity(), q_est = Eigen::Quaterniond::Identity();
   Eigen::Vector3d p_sigma = Eigen::Vector3d::Zero();  // sqrt of diag of the position covariance
   // NEES of the position and of the velocity alone (3 dof each, their marginal covariances):
   // says which block of the state is over- or underconfident when the total is off.

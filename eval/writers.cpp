@@ -222,14 +222,14 @@ void write_tum_trajectories(const RunRecord& run, const fs::path& dir) {
     for (auto* b : {&est, &gt}) {
       fmt::format_to(std::back_inserter(*b), "# timestamp tx ty tz qx qy qz qw\n");
     }
+    const auto line = [](fmt::memory_buffer& b, double t, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+      fmt::format_to(std::back_inserter(b), "{:.9f} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g}\n", t, p.x(),
+                     p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
+    };
     for (const StepRecord& s : run.steps) {
       if (a >= s.agents.size()) continue;
-      const Eigen::Vector3d& pe = s.agents[a].p_est;
-      const Eigen::Vector3d& pt = s.agents[a].p_true;
-      fmt::format_to(std::back_inserter(est), "{:.9f} {:.9g} {:.9g} {:.9g} 0 0 0 1\n", s.t,
-                     pe.x(), pe.y(), pe.z());
-      fmt::format_to(std::back_inserter(gt), "{:.9f} {:.9g} {:.9g} {:.9g} 0 0 0 1\n", s.t,
-                     pt.x(), pt.y(), pt.z());
+      line(est, s.t, s.agents[a].p_est, s.agents[a].q_est);
+      line(gt, s.t, s.agents[a].p_true, s.agents[a].q_true);
     }
     write_file(dir / (run.agent_names[a] + ".est.tum"), fmt::to_string(est));
     write_file(dir / (run.agent_names[a] + ".gt.tum"), fmt::to_string(gt));

@@ -22,7 +22,7 @@ void write_metrics_json(const Metrics& metrics, const RunRecord& run,
                         const std::filesystem::path& path);
 
 // <dir>/<agent>.est.tum and <dir>/<agent>.gt.tum for every agent, one line per step:
-// "timestamp tx ty tz qx qy qz qw" in seconds with an identity quaternion (positions only).
+// "timestamp tx ty tz qx qy qz qw" in seconds, q the agent's orientation (AgentStep::q_true/q_est).
 void write_tum_trajectories(const RunRecord& run, const std::filesystem::path& dir);
 
 // One row per step: k, t, phase, per-agent truth/estimate/sigma, NEES, map and timing columns.

@@ -154,13 +154,17 @@ WorldDescription describe_world(const Scenario& scn) {
   return {scn.world, std::move(terrain), std::move(objects), scn.source_path, scn.world.seed.resolve(scn.seed)};
 }
 
-LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world) {
+double lead_heading(const Truth& truth, double t) {
   const KinematicState k = truth.lead(t);
-  LeadPose p;
-  p.position = k.position;
   Eigen::Vector3d v = k.velocity;
   if (v.head<2>().norm() < 1e-6) v = truth.lead(t + 0.1).position - k.position;
-  p.yaw = std::atan2(v.y(), v.x()) + world.lead.yaw_offset;
+  return std::atan2(v.y(), v.x());
+}
+
+LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world) {
+  LeadPose p;
+  p.position = truth.lead(t).position;
+  p.yaw = lead_heading(truth, t) + world.lead.yaw_offset;
   return p;
 }
 

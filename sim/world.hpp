@@ -240,5 +240,7 @@ struct LeadPose {
   double yaw = 0;
 };
 LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world);
+// The lead's heading about world z at t: its direction of travel (that of t + 0.1 s at a standstill).
+double lead_heading(const Truth& truth, double t);
 
 }  // namespace wingman::sim

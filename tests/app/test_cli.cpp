@@ -185,6 +185,39 @@ TEST_F(CliTest, RunWritesCompleteResultsDirectory) {
   int cols = 0;
   for (std::string tok; row >> tok;) ++cols;
   EXPECT_EQ(cols, 8);
+  // Orientations, unit quaternions: the lead's turns about z only (its heading); the cameras' are
+  // nadir, a half turn about the world's x (q_WC = (1, 0, 0, 0) in TUM's qx qy qz qw order, up to
+  // the gimbal error).
+  for (const char* f : {"traj/lead.gt.tum", "traj/lead.est.tum", "traj/uav1.gt.tum", "traj/uav1.est.tum"}) {
+    const auto rows = lines_of(read_file(dir / f));
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+      std::istringstream r(rows[i]);
+      double t, x, y, z, qx, qy, qz, qw;
+      ASSERT_TRUE(r >> t >> x >> y >> z >> qx >> qy >> qz >> qw) << f;
+      ASSERT_NEAR(qx * qx + qy * qy + qz * qz + qw * qw, 1.0, 1e-6) << f << ": " << rows[i];
+      if (std::string(f).find("lead") != std::string::npos)
+        ASSERT_TRUE(qx == 0 && qy == 0) << f << ": a heading turns about z only: " << rows[i];
+      else
+        ASSERT_GT(std::abs(qx), 0.99) << f << ": a nadir camera: " << rows[i];
+    }
+  }
+  // What evo computes from these files (unaligned translation APE over all N lines) is Table 4's
+  // total scaled by (N-1)/N: step 0 starts at the truth and Table 4 leaves it out.
+  {
+    const auto est = lines_of(read_file(dir / "traj/lead.est.tum")), gt = lines_of(read_file(dir / "traj/lead.gt.tum"));
+    ASSERT_EQ(est.size(), gt.size());
+    double sum = 0;
+    for (std::size_t i = 1; i < est.size(); ++i) {
+      std::istringstream a(est[i]), b(gt[i]);
+      double ta, tb, xa, ya, za, xb, yb, zb;
+      ASSERT_TRUE(a >> ta >> xa >> ya >> za && b >> tb >> xb >> yb >> zb);
+      sum += (xa - xb) * (xa - xb) + (ya - yb) * (ya - yb) + (za - zb) * (za - zb);
+    }
+    const double n = static_cast<double>(est.size() - 1);
+    double table4 = 0;
+    for (const auto& m : j.at("table4").at("total").at("lead").at("mse")) table4 += m.get<double>();
+    EXPECT_NEAR(sum / n, (n - 1) / n * table4, 1e-6 * table4);
+  }
 
   // Running again into the results directory is refused without --force; with it, replaces it.
   const auto before = fs::last_write_time(out / "multi" / "metrics.json");

@@ -111,10 +111,13 @@ TEST(Writers, TumTrajectoriesParseBack) {
   RunRecord run = test::make_record();
   run.steps[3].t = 3.123456789;
   run.steps[3].agents[1].p_est = Eigen::Vector3d(-1234.56789012, 1e-7, 98765.4321);
+  for (std::size_t k = 0; k < run.steps.size(); ++k)  // a camera turning about a tilted axis
+    run.steps[k].agents[1].q_est =
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * static_cast<double>(k), Eigen::Vector3d(1, 2, 3).normalized()));
   write_tum_trajectories(run, tmp.path() / "traj");
 
   const std::regex line_re(
-      R"(-?\d+\.\d{9}( \S+){3} 0 0 0 1)");
+      R"(-?\d+\.\d{9}( \S+){7})");
   for (const std::string& agent : run.agent_names) {
     for (const char* kind : {"est", "gt"}) {
       const fs::path p = tmp.path() / "traj" / (agent + "." + kind + ".tum");
@@ -137,8 +140,11 @@ TEST(Writers, TumTrajectoriesParseBack) {
     EXPECT_NEAR(x, p.x(), 1e-8 * std::abs(p.x()) + 1e-12);
     EXPECT_NEAR(y, p.y(), 1e-8 * std::abs(p.y()) + 1e-12);
     EXPECT_NEAR(z, p.z(), 1e-8 * std::abs(p.z()) + 1e-12);
-    EXPECT_EQ(qw, 1.0);
-    EXPECT_EQ(qx, 0.0);
+    const Eigen::Quaterniond& q = run.steps[k].agents[1].q_est;  // TUM's order: qx qy qz qw
+    EXPECT_NEAR(qx, q.x(), 1e-9);
+    EXPECT_NEAR(qy, q.y(), 1e-9);
+    EXPECT_NEAR(qz, q.z(), 1e-9);
+    EXPECT_NEAR(qw, q.w(), 1e-9);
   }
   EXPECT_EQ(split(lines[4], ' ')[0], "3.123456789");
 }
