@@ -146,7 +146,8 @@ Subcommand add_run(CLI::App& parent) {
                   "Rendered scenarios: write every camera in the filter side by side at half size, "
                   "with the tracked landmarks (red; green once the filter accepted them, so red "
                   "alone is a rejected one), new landmarks' pixels (yellow) and the lead detection "
-                  "(magenta); MJPG AVI, one file per variant, FILE_<variant>.avi, when several run");
+                  "(magenta), each camera labelled with the time and the phase, a legend of the marks "
+                  "underneath; MJPG AVI, one file per variant, FILE_<variant>.avi, when several run");
   cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
   cmd->add_flag("--no-prefetch", o->no_prefetch,
                 "Rendered, open loop: render each step's frames at that step, not during the "

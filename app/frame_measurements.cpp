@@ -169,7 +169,8 @@ void FrameMeasurements::end_step(double t) {
   std::vector<VideoOverlay::Tile> tiles;
   for (int j = 0; j < frontend_.num_cameras(); ++j)
     tiles.push_back({&now_[j].frame, &frontend_.marks(j), lead_[j]});
-  video_->write(tiles, t);
+  const int phase = cfg_.phase_at(t);
+  video_->write(tiles, t, phase < 0 ? "" : cfg_.phases[static_cast<std::size_t>(phase)].name);
 }
 
 void FrameMeasurements::finish(eval::RunRecord& rec) {

@@ -1,6 +1,7 @@
 // --video: every camera side by side (half size) per step, with the frontend's work drawn on it:
 // tracked landmarks (red, green once the filter accepted them), new landmarks' pixels (yellow)
-// and the lead detection (magenta). MJPG in AVI.
+// and the lead detection (magenta); each tile labelled with its UAV, the time and the phase, and a
+// legend of the marks under the tiles. MJPG in AVI.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,12 +28,23 @@ class VideoOverlay {
     const VisionFrontend::Marks* marks = nullptr;
     std::optional<Eigen::Vector2d> lead;
   };
-  void write(const std::vector<Tile>& tiles, double t);
+  // `phase`: the scenario's phase at t ("" outside every phase).
+  void write(const std::vector<Tile>& tiles, double t, const std::string& phase);
+  // The composed image of one step (what write() adds to the video).
+  cv::Mat compose(const std::vector<Tile>& tiles, double t, const std::string& phase) const;
+  cv::Size size() const { return size_; }
 
  private:
   std::vector<geometry::PinholeCamera> models_;
   std::vector<std::string> names_;
   std::unique_ptr<cv::VideoWriter> video_;
+  cv::Mat legend_;  // the strip under the tiles, drawn once
+  cv::Size size_;
 };
+
+// A tile's label: "<uav>  t = <s> s  <phase>".
+std::string overlay_label(const std::string& name, double t, const std::string& phase);
+// Height of the legend strip under the tiles, in pixels.
+inline constexpr int kLegendHeight = 26;
 
 }  // namespace wingman::app
