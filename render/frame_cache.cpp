@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <system_error>
@@ -29,6 +30,7 @@ double ms_since(Clock::time_point t0) {
 }
 
 constexpr char kMagic[8] = {'W', 'M', 'F', 'R', 'A', 'M', 'E', '1'};
+constexpr const char* kMarkerFile = ".wingman-frame-cache";
 // zstd's fastest level: even so a 1 MP frame costs about 5x a raw one's CPU to store and 4x to
 // read back, for 30 % fewer bytes (bench/bench_frame_cache.cpp).
 constexpr int kZstdLevel = 1;
@@ -207,6 +209,14 @@ FrameCache::FrameCache(fs::path dir, std::uint64_t max_bytes, FrameCodec codec)
                                          ec ? ec.message() : "not a directory"));
   if (::access(dir_.c_str(), W_OK) != 0)
     throw std::runtime_error(fmt::format("{}: the frame cache directory is not writable", dir_.string()));
+  // A directory of someone else's files is never taken over (the cache removes files as it evicts).
+  const fs::path marker = dir_ / kMarkerFile;
+  if (!fs::exists(marker)) {
+    if (!fs::is_empty(dir_, ec))
+      throw std::runtime_error(fmt::format("{}: not empty and not a wingman frame cache (no {}); choose a new or "
+                                           "empty directory", dir_.string(), kMarkerFile));
+    std::ofstream(marker) << "wingman frame cache: render/frame_cache.hpp, docs/frame_cache.md\n";
+  }
 }
 
 fs::path FrameCache::entry_path(const FrameKey& key) const {
@@ -314,7 +324,9 @@ void FrameCache::evict_if_full() {
   const auto stale = fs::file_time_type::clock::now() - std::chrono::hours(1);
   for (auto it = fs::recursive_directory_iterator(dir_, ec); !ec && it != fs::recursive_directory_iterator();
        it.increment(ec)) {
-    if (!it->is_regular_file(ec)) continue;
+    if (it.depth() == 0 && it->is_directory(ec) && it->path().filename().string().size() != 2)
+      it.disable_recursion_pending();  // entries live in dir/<2 hex digits>/ only
+    if (it.depth() != 1 || !it->is_regular_file(ec)) continue;
     const auto when = it->last_write_time(ec);
     const auto name = it->path().filename().string();
     if (name.rfind(".tmp-", 0) == 0) {

@@ -51,7 +51,8 @@ struct FrameCacheStats {
 
 class FrameCache {
  public:
-  // Creates `dir` when missing; throws std::runtime_error naming it when it cannot.
+  // Creates `dir` when missing, marking it as a frame cache; throws std::runtime_error naming it
+  // when it cannot, or when it holds files and is not a frame cache (eviction removes files).
   FrameCache(std::filesystem::path dir, std::uint64_t max_bytes, FrameCodec codec = FrameCodec::Raw);
 
   // The frame stored under `key`, or nothing. A damaged entry is reported to the warning

@@ -249,6 +249,20 @@ TEST(FrameCache, ReadersNeverSeeAHalfWrittenEntry) {
   EXPECT_GE(hits, 200);  // every read found a whole entry
 }
 
+TEST(FrameCache, NeverTakesOverADirectoryOfOtherFiles) {
+  TempDir dir;
+  fs::create_directories(dir.path);
+  std::ofstream(dir.path / "thesis.tex") << "mine";
+  EXPECT_THROW(FrameCache(dir.path, 1ull << 30), std::runtime_error);
+  EXPECT_TRUE(fs::exists(dir.path / "thesis.tex"));
+  // An empty directory becomes one, and opens again as one once it holds entries.
+  TempDir empty;
+  fs::create_directories(empty.path);
+  FrameCache(empty.path, 1ull << 30).store({1, 1}, make_frame(16, 16, 7));
+  FrameCache again(empty.path, 1ull << 30);
+  EXPECT_TRUE(again.load({1, 1}));
+}
+
 TEST(FrameCache, SizesReadAsBytesWithBinaryUnits) {
   EXPECT_EQ(parse_byte_size("1048576"), 1048576u);
   EXPECT_EQ(parse_byte_size("512M"), 512ull << 20);
