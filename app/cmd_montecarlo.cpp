@@ -214,7 +214,8 @@ EngineEnd run_engine(const MonteCarloOptions& o, const fs::path& out, const std:
                      const std::vector<std::uint64_t>& pending, SeedOutcomes& seeds) {
   RunSpec spec{o.scenario, o.variants, o.limit, frame_cache_of(o, out, scenarios)};
   if (o.engine == "slurm") {
-    SlurmStudy study{spec, fs::absolute(out), scenarios.front().name, o.quiet};
+    SlurmStudy study{spec, fs::absolute(out), scenarios.front().name, o.quiet,
+                     !spec.frame_cache.dir.empty() && cache_is_empty(spec.frame_cache.dir)};
     study.spec.scenario = fs::absolute(o.scenario).string();  // the tasks may start elsewhere
     return run_slurm(study, o.slurm, pending, seeds);
   }

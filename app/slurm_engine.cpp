@@ -66,13 +66,14 @@ std::string seed_range(const std::vector<std::uint64_t>& seeds) {
 }
 
 // Writes submission k's seeds and script, submits it and records the job; a refused submission
-// leaves neither file behind.
-std::vector<Task> submit(const SlurmStudy& s, const SlurmOptions& o, const std::vector<std::uint64_t>& seeds) {
+// leaves neither file behind. `after`: a job the tasks wait for (its id), or "".
+std::vector<Task> submit(const SlurmStudy& s, const SlurmOptions& o, const std::vector<std::uint64_t>& seeds,
+                         const std::string& after = "") {
   fs::create_directories(slurm_dir(s.out) / "logs");
   fs::create_directories(slurm_dir(s.out) / "status");
   int k = 1;
   while (fs::exists(script_path(s.out, k)) || fs::exists(seeds_path(s.out, k))) ++k;
-  const ArrayJob job{s.out, k, seeds, "wingman-" + s.name, fs::read_symlink("/proc/self/exe"), fs::current_path()};
+  const ArrayJob job{s.out, k, seeds, "wingman-" + s.name, fs::read_symlink("/proc/self/exe"), fs::current_path(), after};
   std::string list;
   for (auto seed : seeds) list += std::to_string(seed) + "\n";
   eval::write_file_atomic(seeds_path(s.out, k), list);
@@ -288,7 +289,14 @@ EngineEnd run_slurm(const SlurmStudy& s, const SlurmOptions& o, const std::vecto
   std::vector<std::uint64_t> rest;
   for (auto seed : pending)
     if (std::none_of(tasks.begin(), tasks.end(), [&](const Task& t) { return t.seed == seed; })) rest.push_back(seed);
-  if (!rest.empty()) {
+  if (rest.size() > 1 && s.fill_cache_first) {
+    // An empty frame cache: the first seed's task renders every frame once, and the others start
+    // when it has ended and read them, instead of each rendering them side by side.
+    auto first = submit(s, o, {rest.front()});
+    auto added = submit(s, o, {rest.begin() + 1, rest.end()}, first.front().job);
+    tasks.insert(tasks.end(), first.begin(), first.end());
+    tasks.insert(tasks.end(), added.begin(), added.end());
+  } else if (!rest.empty()) {
     auto added = submit(s, o, rest);
     tasks.insert(tasks.end(), added.begin(), added.end());
   }

@@ -20,6 +20,8 @@ struct SlurmStudy {
   std::filesystem::path out;   // absolute
   std::string name;            // the scenario's name, for the job's
   bool quiet = false;
+  // The study's frame cache is empty: its first seed runs alone, the others after it.
+  bool fill_cache_first = false;
 };
 
 // A UsageError when sbatch or squeue is not on PATH.

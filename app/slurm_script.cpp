@@ -32,6 +32,7 @@ std::string sbatch_lines(const ArrayJob& job, const SlurmOptions& o) {
   if (!o.partition.empty()) s += fmt::format("#SBATCH --partition={}\n", o.partition);
   if (!o.time.empty()) s += fmt::format("#SBATCH --time={}\n", o.time);
   if (!o.mem.empty()) s += fmt::format("#SBATCH --mem={}\n", o.mem);
+  if (!job.after.empty()) s += fmt::format("#SBATCH --dependency=afterany:{}\n", job.after);
   return s;
 }
 

@@ -32,6 +32,7 @@ struct ArrayJob {
   std::string name;                  // Slurm's job name
   std::filesystem::path wingman;     // the binary the tasks run, absolute
   std::filesystem::path cwd;         // the tasks' working directory: the submitter's
+  std::string after;                 // a job id: start once it has ended (--dependency=afterany)
 };
 
 std::filesystem::path slurm_dir(const std::filesystem::path& out);

@@ -19,6 +19,8 @@
 #include <thread>
 
 #include "app_test_support.hpp"
+#include "gl_required.hpp"
+#include "render/gl_context.hpp"
 
 extern char** environ;
 
@@ -291,4 +293,38 @@ TEST(MonteCarloEngines, BadEngineOptionsExit2AndLeaveNoBatch) {
   EXPECT_THAT(output, HasSubstr("sbatch was not found on PATH")) << output;
   EXPECT_FALSE(fs::exists(out / "montecarlo.json"));
   EXPECT_FALSE(fs::exists(out / "slurm" / "jobs"));
+}
+
+// A rendered study through Slurm shares one frame cache in the output directory: with the cache
+// empty, the first seed's task runs alone and fills it, the others wait for it
+// (--dependency=afterany) and read every frame back; the study is the uncached local one's.
+TEST(MonteCarloSlurm, TasksShareTheStudysFrameCacheFilledByTheFirstSeed) {
+  try {
+    wingman::render::create_gl_context(wingman::render::GlBackend::Auto);
+  } catch (const wingman::render::GlContextError& e) {
+    WINGMAN_NO_GL_CONTEXT(e.what());
+  }
+  TempDir tmp;
+  START_LOCAL_CLUSTER(cluster, tmp / "cluster");
+  const fs::path rendered = kSourceDir / "scenes" / "rendered_smoke.yaml";
+  auto args = [&](const fs::path& out, std::vector<std::string> more) {
+    std::vector<std::string> a = {"montecarlo", rendered.string(), "--runs", "3", "--frames", "4", "--out",
+                                  out.string(), "--no-plots", "--variant", "multi"};
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  };
+  const RunResult s = run_wingman(args(tmp / "slurm", {"--engine", "slurm"}), tmp.path());
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const RunResult l = run_wingman(args(tmp / "local", {"--no-frame-cache"}), tmp.path());
+  ASSERT_EQ(l.exit_code, 0) << l.output;
+  EXPECT_EQ(read_file(tmp / "slurm" / "montecarlo.json"), read_file(tmp / "local" / "montecarlo.json"));
+  EXPECT_THAT(read_file(tmp / "slurm" / "slurm" / "array-2.sbatch"), HasSubstr("#SBATCH --dependency=afterany:"));
+  auto cache_of = [&](const char* seed) {
+    return nlohmann::json::parse(read_file(tmp / "slurm" / "runs" / seed / "multi" / "metrics.json"))["frame_cache"];
+  };
+  EXPECT_EQ(cache_of("seed1")["misses"], 6);  // steps 1-3, two cameras
+  for (const char* seed : {"seed2", "seed3"}) {
+    EXPECT_EQ(cache_of(seed)["hits"], 6) << seed;
+    EXPECT_EQ(cache_of(seed)["misses"], 0) << seed;
+  }
 }

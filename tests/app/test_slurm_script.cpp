@@ -14,7 +14,7 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 
 TEST(SlurmScript, RunsTheLocalWorkersCommandWithTheSeedFromItsTask) {
-  const ArrayJob job{"/shared/mc", 2, {5, 6, 9}, "wingman-smoke", "/opt/bin/wingman", "/home/me"};
+  const ArrayJob job{"/shared/mc", 2, {5, 6, 9}, "wingman-smoke", "/opt/bin/wingman", "/home/me", ""};
   RunSpec spec{"/home/me/scenes/it's.yaml", {"multi"}, {}, {}};
   spec.limit.frames = 40;
   const SlurmOptions options{"gpu", "1:00:00", "2G", 2, false};
@@ -37,6 +37,11 @@ TEST(SlurmScript, RunsTheLocalWorkersCommandWithTheSeedFromItsTask) {
   cached.frame_cache = {"/shared/mc/frame_cache", 1ull << 30};
   EXPECT_THAT(array_script(job, cached, options),
               HasSubstr("'--frames' '40' '--frame-cache' '/shared/mc/frame_cache' '--frame-cache-size' '1073741824' >"));
+  // A submission that waits for another job (the one filling an empty frame cache).
+  ArrayJob after = job;
+  after.after = "41";
+  EXPECT_THAT(array_script(after, spec, options), HasSubstr("#SBATCH --dependency=afterany:41\n"));
+  EXPECT_THAT(array_script(job, spec, options), Not(HasSubstr("--dependency")));
   // Options left out are the cluster's defaults.
   EXPECT_THAT(array_script(job, spec, {}), Not(HasSubstr("--partition")));
   EXPECT_THAT(array_script(job, spec, {}), HasSubstr("#SBATCH --array=0-2\n"));
