@@ -6,7 +6,6 @@
 // be made.
 #include <benchmark/benchmark.h>
 
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -14,6 +13,7 @@
 #include <optional>
 
 #include "render/frame_cache.hpp"
+#include "bench/process_cpu.hpp"
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene.hpp"
@@ -29,12 +29,7 @@ namespace {
 using namespace wingman;
 namespace fs = std::filesystem;
 
-double process_cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
+using bench::process_cpu_seconds;
 
 // The paper scene's world, one camera's view of it, and a context that renders it.
 struct PaperFrame {

@@ -8,12 +8,12 @@
 // allow, one ratio that holds on any machine.
 #include <benchmark/benchmark.h>
 
-#include <sys/resource.h>
 
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
 
+#include "bench/process_cpu.hpp"
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene.hpp"
@@ -28,14 +28,7 @@ namespace {
 
 using namespace wingman;
 
-// CPU seconds of the whole process (llvmpipe's rasteriser threads included): on a machine shared
-// with other work, this says what a frame costs better than wall time does.
-double process_cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
+using bench::process_cpu_seconds;
 
 // A context of the backend, or nullptr with the benchmark skipped and the reason given.
 std::unique_ptr<render::GlContext> context_or_skip(benchmark::State& state, render::GlBackend backend) {

@@ -7,7 +7,20 @@
 #include <cstdlib>
 #include <string>
 
+#include "render/gl_context.hpp"
+
 namespace wingman::testing {
+
+// Whether this machine can make an OpenGL context of any backend; if not, *why says why.
+inline bool gl_available(std::string* why) {
+  try {
+    render::create_gl_context(render::GlBackend::Auto);
+    return true;
+  } catch (const render::GlContextError& e) {
+    *why = e.what();
+    return false;
+  }
+}
 
 inline bool gl_required() {
   const char* ci = std::getenv("CI");

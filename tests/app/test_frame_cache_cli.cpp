@@ -12,7 +12,6 @@
 
 #include "app_test_support.hpp"
 #include "gl_required.hpp"
-#include "render/gl_context.hpp"
 
 using namespace wingman::app::test;
 using ::testing::HasSubstr;
@@ -34,16 +33,6 @@ RunResult run_smoke(const TempDir& tmp, const std::string& out, const std::strin
   return run_wingman(args, tmp.path());
 }
 
-// Why no OpenGL context can be made here, or "" when one can.
-std::string no_gl_context() {
-  try {
-    wingman::render::create_gl_context(wingman::render::GlBackend::Auto);
-    return "";
-  } catch (const wingman::render::GlContextError& e) {
-    return e.what();
-  }
-}
-
 void expect_same_results(const TempDir& tmp, const std::string& a, const std::string& b) {
   const RunResult r = run_wingman({"check", (tmp / a).string(), "--against", (tmp / b).string()}, tmp.path());
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -51,7 +40,7 @@ void expect_same_results(const TempDir& tmp, const std::string& a, const std::st
 }
 
 TEST(FrameCacheCli, CachedRunsGiveTheUncachedResults) {
-  if (const std::string why = no_gl_context(); !why.empty()) WINGMAN_NO_GL_CONTEXT(why);
+  if (std::string why; !wingman::testing::gl_available(&why)) WINGMAN_NO_GL_CONTEXT(why);
   TempDir tmp;
   const std::string cache = (tmp / "cache").string();
   ASSERT_EQ(run_smoke(tmp, "plain", "multi").exit_code, 0);
@@ -92,7 +81,7 @@ TEST(FrameCacheCli, CachedRunsGiveTheUncachedResults) {
 }
 
 TEST(FrameCacheCli, MonteCarloSharesOneCacheAndGivesTheUncachedStudy) {
-  if (const std::string why = no_gl_context(); !why.empty()) WINGMAN_NO_GL_CONTEXT(why);
+  if (std::string why; !wingman::testing::gl_available(&why)) WINGMAN_NO_GL_CONTEXT(why);
   TempDir tmp;
   auto study = [&](const std::string& out, const std::vector<std::string>& extra) {
     std::vector<std::string> args = {"montecarlo", kRenderedSmoke.string(), "--runs", "3", "--jobs", "2",

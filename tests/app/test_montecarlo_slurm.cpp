@@ -20,7 +20,6 @@
 
 #include "app_test_support.hpp"
 #include "gl_required.hpp"
-#include "render/gl_context.hpp"
 
 extern char** environ;
 
@@ -299,11 +298,7 @@ TEST(MonteCarloEngines, BadEngineOptionsExit2AndLeaveNoBatch) {
 // empty, the first seed's task runs alone and fills it, the others wait for it
 // (--dependency=afterany) and read every frame back; the study is the uncached local one's.
 TEST(MonteCarloSlurm, TasksShareTheStudysFrameCacheFilledByTheFirstSeed) {
-  try {
-    wingman::render::create_gl_context(wingman::render::GlBackend::Auto);
-  } catch (const wingman::render::GlContextError& e) {
-    WINGMAN_NO_GL_CONTEXT(e.what());
-  }
+  if (std::string why; !wingman::testing::gl_available(&why)) WINGMAN_NO_GL_CONTEXT(why);
   TempDir tmp;
   START_LOCAL_CLUSTER(cluster, tmp / "cluster");
   const fs::path rendered = kSourceDir / "scenes" / "rendered_smoke.yaml";

@@ -28,16 +28,7 @@ app::RunConfig variant(const std::string& name) {
   throw std::runtime_error("no variant " + name);
 }
 
-// Whether this machine can make an OpenGL context at all (as tests/render check).
-bool gl_available(std::string* why) {
-  try {
-    render::create_gl_context(render::GlBackend::Auto);
-    return true;
-  } catch (const render::GlContextError& e) {
-    *why = e.what();
-    return false;
-  }
-}
+using wingman::testing::gl_available;
 
 // One run, every check: ctest runs each TEST in its own process, so separate tests sharing a
 // fixture would each render the whole scenario again.
