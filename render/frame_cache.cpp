@@ -31,8 +31,8 @@ double ms_since(Clock::time_point t0) {
 
 constexpr char kMagic[8] = {'W', 'M', 'F', 'R', 'A', 'M', 'E', '1'};
 constexpr const char* kMarkerFile = ".wingman-frame-cache";
-// zstd's fastest level: even so a 1 MP frame costs about 5x a raw one's CPU to store and 4x to
-// read back, for 30 % fewer bytes (bench/bench_frame_cache.cpp).
+// zstd's fastest level: even so a 1 MP frame costs about 4.5x a raw one's CPU to store and 9x to
+// read back, for 30 % fewer bytes (bench/bench_frame_cache.cpp, docs/frame_cache.md).
 constexpr int kZstdLevel = 1;
 
 struct Header {
@@ -291,11 +291,12 @@ void FrameCache::store(const FrameKey& key, const Frame& frame) {
          std::fwrite(depth_p, 1, depth_s, f) == depth_s;
     ok = (std::fclose(f) == 0) && ok;
   }
+  const std::string write_error = ok ? "" : std::strerror(errno);
   if (ok) fs::rename(tmp, path, ec);  // atomic: readers see the whole entry or none
   if (!ok || ec) {
+    const std::string why = ok ? ec.message() : write_error;  // before the clean-up touches errno or ec
     fs::remove(tmp, ec);
-    warn(fmt::format("{}: cannot write a frame cache entry ({}); the run goes on without it", path.string(),
-                     ok ? ec.message() : std::strerror(errno)));
+    warn(fmt::format("{}: cannot write a frame cache entry ({}); the run goes on without it", path.string(), why));
     stats_.write_ms += ms_since(t0);
     return;
   }
