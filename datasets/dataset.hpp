@@ -56,11 +56,34 @@ struct CameraInfo {
   int channels = 3;  // 3: RGB colour, 1: gray
 };
 
-struct PoseSample {  // groundtruth/data.csv (body) and groundtruth/cam0.csv (camera, R_CW)
+// A body pose (state_groundtruth_estimate0: p_WB, q = R_WB, velocity in the world frame and the
+// IMU's true biases) or a camera pose (cam0_pose0: p = camera centre in the world, q = R_CW, the
+// world-to-camera rotation; v and the biases unused).
+struct PoseSample {
   std::int64_t t_ns = 0;
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   Eigen::Vector4d q_xyzw{0, 0, 0, 1};
-  Eigen::Vector3d v = Eigen::Vector3d::Zero();  // body only
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();    // body only
+  Eigen::Vector3d b_w = Eigen::Vector3d::Zero();  // gyroscope bias, rad/s (body with an IMU)
+  Eigen::Vector3d b_a = Eigen::Vector3d::Zero();  // accelerometer bias, m/s^2
+};
+
+// imu0/data.csv: angular rate and specific force in the IMU (= body) frame, biases and noise
+// included, as EuRoC's w_RS_S and a_RS_S.
+struct ImuSample {
+  std::int64_t t_ns = 0;
+  Eigen::Vector3d w_S = Eigen::Vector3d::Zero();  // rad/s
+  Eigen::Vector3d a_S = Eigen::Vector3d::Zero();  // m/s^2
+};
+
+// imu0/sensor.yaml: the continuous-time noise model the samples were drawn with (Kalibr's and
+// EuRoC's keys and units).
+struct ImuInfo {
+  double rate = 200;                          // Hz
+  double gyroscope_noise_density = 0;         // rad/s/sqrt(Hz)
+  double gyroscope_random_walk = 0;           // rad/s^2/sqrt(Hz)
+  double accelerometer_noise_density = 0;     // m/s^2/sqrt(Hz)
+  double accelerometer_random_walk = 0;       // m/s^3/sqrt(Hz)
 };
 
 struct Vec3Sample {
@@ -78,7 +101,9 @@ struct AgentData {
   std::optional<CameraInfo> camera;     // UAVs
   std::vector<std::int64_t> frames;     // cam0 and depth0 time stamps
   std::vector<PoseSample> groundtruth;  // body
-  std::vector<PoseSample> camera_pose;  // true camera pose (with gimbal error)
+  std::vector<PoseSample> camera_pose;  // true camera pose (with gimbal error), one per frame
+  std::optional<ImuInfo> imu_info;      // UAVs (format version 2)
+  std::vector<ImuSample> imu;
   std::vector<Vec3Sample> gps;
   std::vector<ScalarSample> altimeter, range, ahrs;
 };
@@ -130,6 +155,8 @@ class DatasetWriter {
   void altimeter(const std::string& agent, const ScalarSample& s);
   void range(const std::string& agent, const ScalarSample& s);
   void ahrs(const std::string& agent, const ScalarSample& s);
+  void imu_info(const std::string& agent, const ImuInfo& info);
+  void imu(const std::string& agent, const ImuSample& s);
   // Waits for the images, then writes the CSVs, the sensor.yaml files and, last, dataset.yaml.
   void finish();
 

@@ -200,6 +200,8 @@ void DatasetWriter::gps(const std::string& agent, const Vec3Sample& s) { get(age
 void DatasetWriter::altimeter(const std::string& agent, const ScalarSample& s) { get(agent).altimeter.push_back(s); }
 void DatasetWriter::range(const std::string& agent, const ScalarSample& s) { get(agent).range.push_back(s); }
 void DatasetWriter::ahrs(const std::string& agent, const ScalarSample& s) { get(agent).ahrs.push_back(s); }
+void DatasetWriter::imu_info(const std::string& agent, const ImuInfo& info) { get(agent).imu_info = info; }
+void DatasetWriter::imu(const std::string& agent, const ImuSample& s) { get(agent).imu.push_back(s); }
 
 void DatasetWriter::finish() {
   encoder_->drain();
