@@ -1,5 +1,5 @@
 // `wingman render`: renders every UAV camera at every step of the open-loop truth and writes an
-// image dataset with depth, sensor samples and ground truth (datasets/dataset.hpp). The dataset
+// image dataset with depth, an IMU, sensor samples and ground truth (datasets/dataset.hpp). The dataset
 // is staged next to --out and renamed into place only when complete, so a failed or interrupted
 // run (Ctrl-C and SIGTERM included, app/interrupt.hpp) never leaves a directory that looks finished.
 #include "app/cli_options.hpp"
@@ -27,6 +27,7 @@
 #include "render/renderer.hpp"
 #include "render/scene.hpp"
 #include "sim/rng.hpp"
+#include "sim/imu.hpp"
 #include "sim/scenario.hpp"
 #include "sim/synthetic_source.hpp"
 #include "sim/truth.hpp"
@@ -44,7 +45,7 @@ struct RenderOptions {
   std::optional<std::uint64_t> seed;
   std::vector<std::string> variants;
   StepLimit limit;
-  bool gray = false;
+  bool gray = false, rgb = false;
   bool force = false;
   bool quiet = false;
 };
@@ -73,6 +74,39 @@ int steps_to_render(const RenderOptions& o, const RunConfig& scn) {
 datasets::PoseSample pose(std::int64_t t, const Eigen::Vector3d& p, const Eigen::Matrix3d& R,
                           const Eigen::Vector3d& v = Eigen::Vector3d::Zero()) {
   return {t, p, geometry::quaternion_xyzw(R), v};
+}
+
+// Grey frames (EuRoC's mono8, what visual(-inertial) loaders read) unless asked otherwise or the
+// scenario's lead cue is found by its colour (a panel): then RGB, so that `wingman slam` replays it.
+int frame_channels(const RenderOptions& o, const RunConfig& scn) {
+  if (o.gray && o.rgb) throw UsageError("--gray and --rgb exclude each other");
+  if (o.gray) return 1;
+  if (o.rgb) return 3;
+  return scn.world.lead.cue == sim::LeadModelSpec::Cue::Panel ? 3 : 1;
+}
+
+// UAV j's IMU (imu0) and its ground truth at the IMU's rate, with the biases in effect, over
+// [0, t_end]: both from the truth's analytic derivatives.
+void write_inertial(datasets::DatasetWriter& writer, const sim::Truth& truth, const RunConfig& scn, int j,
+                    double t_end) {
+  const auto& spec = scn.noise.imu;
+  const std::string& name = scn.uavs[j].name;
+  writer.imu_info(name, {spec.rate, spec.gyroscope_noise_density, spec.gyroscope_random_walk,
+                         spec.accelerometer_noise_density, spec.accelerometer_random_walk});
+  sim::ImuSimulator imu(spec, scn.seed, name);
+  const int m = static_cast<int>(std::floor(t_end * spec.rate + 1e-9));
+  for (int i = 0; i <= m; ++i) {
+    const double t = i / spec.rate;
+    const std::int64_t t_ns = datasets::step_ns(i, spec.rate);
+    const sim::BodyMotion body = sim::uav_body_motion(truth, j, t);
+    const sim::ImuReading r = imu.measure(body);
+    writer.imu(name, {t_ns, r.w_S, r.a_S});
+    const sim::KinematicState q = truth.uav(j, t);
+    datasets::PoseSample gt = pose(t_ns, q.position, body.R_WB, q.velocity);
+    gt.b_w = r.b_w;
+    gt.b_a = r.b_a;
+    writer.ground_truth(name, gt);
+  }
 }
 
 // One variant's dataset into `out` (or, with several variants, out/<variant>).
@@ -123,7 +157,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
     c.R_CW = truth.commanded_R_CW();
     c.offset = u.camera.offset;
     c.rate = scn.rate;
-    c.channels = o.gray ? 1 : 3;
+    c.channels = frame_channels(o, scn);
     writer.add_agent(u.name, c);
     effects.emplace_back(scn.world.image, scn.seed, u.name);
   }
@@ -144,13 +178,10 @@ int render_command(const RenderOptions& o, const std::string& variant) {
     for (int j = 0; j < cams; ++j) {
       const Eigen::Matrix3d R_CW = truth.camera_R_CW(j, t);
       const auto& u = scn.uavs[j];
-      const sim::KinematicState q = truth.uav(j, t);
       const Eigen::Vector3d x_c = truth.camera(j, t).position;
       render::Frame f = renderer.render({u.camera.camera(), R_CW, x_c}, lead);
       effects[j].apply(f);
       writer.write_frame(u.name, t_ns, f.rgb, f.depth);
-      // Open loop: the UAVs keep yaw 0 (their camera's x along world x).
-      writer.ground_truth(u.name, pose(t_ns, q.position, Eigen::Matrix3d::Identity(), q.velocity));
       writer.camera_pose(u.name, pose(t_ns, x_c, R_CW));
       if (u.altimeter) writer.altimeter(u.name, {t_ns, sensors.altimeter(j, t)});
       if (u.range) writer.range(u.name, {t_ns, sensors.range(j, t)});
@@ -162,6 +193,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
                     fmt::format("steps, {:.1f} frames/s", secs > 0 ? (k + 1) * cams / secs : 0.0));
   }
   progress.finish();
+  for (int j = 0; j < cams; ++j) write_inertial(writer, truth, scn, j, n * scn.dt());
   writer.finish();
   fs::copy_file(o.scenario, staged->staging() / "scenario.yaml");
   staged->commit();
@@ -177,7 +209,7 @@ Subcommand add_render(CLI::App& parent) {
   auto o = std::make_shared<RenderOptions>();
   auto* cmd = parent.add_subcommand(
       "render", "Render every UAV camera along the open-loop truth into an image dataset with "
-                "depth, sensor samples and ground truth (EuRoC/ASL layout)");
+                "depth, an IMU, sensor samples and ground truth (EuRoC/ASL layout, docs/datasets.md)");
   cmd->add_option("scenario", o->scenario, "Scenario YAML file")->required();
   cmd->add_option("--out,-o", o->out, "Dataset directory (default: datasets/<scenario name>)");
   cmd->add_option("--gl", o->gl, "OpenGL backend: auto (EGL, then OSMesa), egl or osmesa")
@@ -187,7 +219,8 @@ Subcommand add_render(CLI::App& parent) {
                      "Which variant's settings to use (default: the first; with several, one dataset "
                      "each, OUT/<variant>)");
   add_step_limit(cmd, o->limit);
-  cmd->add_flag("--gray", o->gray, "Write 8-bit gray frames instead of RGB");
+  cmd->add_flag("--gray", o->gray, "Write 8-bit grey frames (the default unless the lead's cue is a colour panel)");
+  cmd->add_flag("--rgb", o->rgb, "Write 8-bit RGB frames (the default when the lead's cue is a colour panel)");
   add_force_flag(cmd, o->force);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
   return {cmd, [o] {

@@ -102,7 +102,7 @@ std::vector<const datasets::AgentData*> check_dataset(const RunConfig& cfg, cons
       const Eigen::Vector3d d = a.camera_pose[k].p - truth.camera(static_cast<int>(u), k * cfg.dt()).position;
       if (d.norm() > 1e-3)
         throw std::invalid_argument(ds.root.string() + "/" + a.name +
-                                    "/groundtruth/cam0.csv: camera positions differ from the truth of the "
+                                    ": true camera positions (cam0_pose0) differ from the truth of the "
                                     "dataset's scenario.yaml (" +
                                     std::to_string(d.norm()) + " m at step " + std::to_string(k) + ")");
     }

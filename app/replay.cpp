@@ -17,9 +17,10 @@ namespace {
 bool same(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max({1.0, std::abs(a), std::abs(b)}); }
 
 // One camera of the dataset against the scenario's UAV it belongs to.
-void check_camera(const datasets::AgentData& a, const sim::UavSpec& u, double scn_rate,
-                  const std::filesystem::path& ds_root, const std::filesystem::path& scn_path) {
-  const auto file = (ds_root / a.name / "cam0" / "sensor.yaml").string();
+void check_camera(const datasets::AgentData& a, const RunConfig& scn, const sim::UavSpec& u,
+                  const datasets::Dataset& ds, const std::filesystem::path& scn_path) {
+  const double scn_rate = scn.rate;
+  const auto file = (ds.layout.sensor(ds.root, a.name, "cam0") / "sensor.yaml").string();
   if (!a.camera) throw UsageError(fmt::format("{}: missing: the scenario's UAV '{}' has a camera", file, u.name));
   const geometry::PinholeCamera& d = a.camera->camera;
   const geometry::PinholeCamera s = u.camera.camera();
@@ -36,10 +37,15 @@ void check_camera(const datasets::AgentData& a, const sim::UavSpec& u, double sc
         "cy {}, or its distortion differs): the frames would be read with the wrong model",
         file, d.width(), d.height(), d.fx(), d.fy(), d.cx(), d.cy(), scn_path.string(), u.name, s.width(), s.height(),
         s.fx(), s.fy(), s.cx(), s.cy()));
+  // A colour panel is found by its hue: grey frames cannot show it.
+  if (scn.world.lead.cue == sim::LeadModelSpec::Cue::Panel && a.camera->channels == 1)
+    throw UsageError(fmt::format("{}: grey frames (encoding mono8), but the lead's cue in {} is a colour panel: "
+                                 "render the dataset with --rgb",
+                                 file, scn_path.string()));
   for (std::size_t k = 0; k < a.frames.size(); ++k)
     if (a.frames[k] != datasets::step_ns(static_cast<int>(k), a.camera->rate))
       throw UsageError(fmt::format("{}: frame {} has time stamp {} ns; at {} Hz it would be {} ns",
-                                   (ds_root / a.name / "cam0" / "data.csv").string(), k + 1, a.frames[k],
+                                   (ds.layout.sensor(ds.root, a.name, "cam0") / "data.csv").string(), k + 1, a.frames[k],
                                    a.camera->rate, datasets::step_ns(static_cast<int>(k), a.camera->rate)));
 }
 
@@ -67,7 +73,8 @@ void check_against_scenario(const datasets::Dataset& ds, const RunConfig& scn, c
   auto samples = [&](const datasets::AgentData& a, const char* folder, std::size_t n) {
     if (n < frames)
       throw UsageError(fmt::format("{}: {} samples for {} frames (the scenario's {} carries it)",
-                                   (ds.root / a.name / folder / "data.csv").string(), n, frames, a.name));
+                                   (ds.layout.sensor(ds.root, a.name, folder) / "data.csv").string(), n, frames,
+                                   a.name));
   };
   if (scn.lead.gps) samples(*lead, "gps0", lead->gps.size());
   for (const auto& u : scn.uavs) {
@@ -75,7 +82,7 @@ void check_against_scenario(const datasets::Dataset& ds, const RunConfig& scn, c
     if (!a)
       throw UsageError(fmt::format("{}: agents: no '{}', a UAV of {} ({})", yf, u.name, scn_path.string(),
                                    scn.uav_names()));
-    check_camera(*a, u, scn.rate, ds.root, scn_path);
+    check_camera(*a, scn, u, ds, scn_path);
     if (a->frames.size() != frames)
       throw UsageError(fmt::format("{}: {} has {} frames, {} has {}", yf, a->name, a->frames.size(),
                                    scn.uavs.front().name, frames));
@@ -83,7 +90,7 @@ void check_against_scenario(const datasets::Dataset& ds, const RunConfig& scn, c
     if (u.range) samples(*a, "range0", a->range.size());
     if (a->groundtruth.size() < a->frames.size())
       throw UsageError(fmt::format("{}: {} poses for {} frames",
-                                   (ds.root / a->name / "groundtruth" / "data.csv").string(), a->groundtruth.size(),
+                                   ds.layout.groundtruth_csv(ds.root, a->name).string(), a->groundtruth.size(),
                                    a->frames.size()));
   }
 }

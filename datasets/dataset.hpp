@@ -1,12 +1,15 @@
-// The on-disk dataset of docs/design.md, files, what `wingman render` writes and a replay reads: one
-// folder per agent in the EuRoC/ASL layout,
-//   <agent>/cam0/data/<t_ns>.png, cam0/data.csv, cam0/sensor.yaml   colour (or gray) frames
-//   <agent>/depth0/data/<t_ns>.png, depth0/data.csv, depth0/sensor.yaml   16-bit depth, mm
-//   <agent>/{gps0,altimeter0,range0,ahrs0}/data.csv                  noisy sensor samples
-//   <agent>/groundtruth/data.csv (+ cam0.csv for a UAV: the true camera pose)
-// and a top-level dataset.yaml (format version, scenario, seed, software version). The writer
-// fills a directory the caller stages (app/cmd_render.cpp renames it into place when complete);
-// the reader validates what it loads and names the file at fault.
+// The on-disk dataset of docs/datasets.md, what `wingman render` writes and a replay reads: one
+// folder per agent in EuRoC's ASL layout (format version 2),
+//   <agent>/mav0/cam0/data/<t_ns>.png, cam0/data.csv, cam0/sensor.yaml   8-bit grey (or RGB) frames
+//   <agent>/mav0/depth0/...                                              16-bit depth, mm
+//   <agent>/mav0/imu0/data.csv, sensor.yaml                              200 Hz IMU, noise model
+//   <agent>/mav0/state_groundtruth_estimate0/data.csv                    EuRoC's 17 columns
+//   <agent>/mav0/cam0_pose0/data.csv                                     true camera pose per frame
+//   <agent>/mav0/{gps0,altimeter0,range0,ahrs0}/                         noisy sensor samples
+// and a top-level dataset.yaml (format version, scenario, seed, software version). Format version
+// 1 (no mav0/, groundtruth/) is still read (datasets/layout.hpp). The writer fills a directory
+// the caller stages (app/cmd_render.cpp renames it into place when complete); the reader
+// validates what it loads and names the file at fault.
 #pragma once
 
 #include <Eigen/Core>
@@ -23,11 +26,12 @@
 #include <string>
 #include <vector>
 
+#include "datasets/layout.hpp"
 #include "geometry/camera.hpp"
 
 namespace wingman::datasets {
 
-inline constexpr int kFormatVersion = 1;
+inline constexpr int kFormatVersion = 2;  // the layout written; version 1 is still read
 // Depth PNGs hold millimetres; 0 means no surface (sky) or farther than 65.535 m.
 inline constexpr double kDepthScale = 0.001;
 
@@ -111,6 +115,7 @@ struct AgentData {
 struct Dataset {
   std::filesystem::path root;
   DatasetInfo info;
+  Layout layout;  // from info.format_version
   std::vector<AgentData> agents;
 
   const AgentData& agent(const std::string& name) const;  // throws DatasetError
@@ -164,6 +169,7 @@ class DatasetWriter {
   struct Encoder;
   AgentData& get(const std::string& agent);
   std::filesystem::path dir_;
+  Layout layout_;
   DatasetInfo info_;
   std::vector<AgentData> agents_;
   std::mutex checksums_mutex_;

@@ -144,13 +144,81 @@ PngHeader png_header(const fs::path& p) {
   return h;
 }
 
-CameraInfo read_camera(const fs::path& file, double rate_fallback) {
+// T_BS of a version-2 sensor.yaml: EuRoC's {cols: 4, rows: 4, data: [16 numbers]}, a rigid
+// transform (a rotation and a last row 0 0 0 1).
+void read_T_BS(const YAML::Node& n, const fs::path& file, Eigen::Matrix3d& R_BS, Eigen::Vector3d& p_BS) {
+  const YAML::Node t = n["T_BS"];
+  if (!t || !t.IsMap()) fail(file, "missing key 'T_BS' (a map with cols, rows and data)");
+  if (get<int>(t, file, "cols") != 4 || get<int>(t, file, "rows") != 4) fail(file, "T_BS: cols and rows must be 4");
+  const auto d = numbers(t, file, "data", 16);
+  for (double x : d)
+    if (!std::isfinite(x) || std::abs(x) > kMaxMagnitude) fail(file, fmt::format("T_BS.data: {} is not finite", x));
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) R_BS(i, j) = d[4 * i + j];
+    p_BS(i) = d[4 * i + 3];
+  }
+  if (d[12] != 0 || d[13] != 0 || d[14] != 0 || d[15] != 1) fail(file, "T_BS.data: the last row must be 0 0 0 1");
+}
+
+void check_rotation(const Eigen::Matrix3d& R, const fs::path& file, const char* key) {
+  const double orth = (R * R.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(orth < 1e-6) || !(std::abs(R.determinant() - 1) < 1e-6))
+    fail(file, fmt::format("{} is not a rotation matrix (R R^T = I and det R = 1, to 1e-6)", key));
+}
+
+// The lens: version 1 always five coefficients; version 2 four for radial-tangential (EuRoC) and
+// five for plumb_bob (k1, k2, p1, p2, k3).
+geometry::Distortion read_distortion(const YAML::Node& n, const fs::path& file, int version) {
+  std::size_t count = 5;
+  if (version >= 2) {
+    const auto model = get<std::string>(n, file, "distortion_model");
+    if (model == "radial-tangential") count = 4;
+    else if (model != "plumb_bob")
+      fail(file, fmt::format("distortion_model '{}': this reader knows radial-tangential and plumb_bob", model));
+  }
+  auto d = numbers(n, file, "distortion_coefficients", count);
+  for (double x : d)
+    if (!std::isfinite(x) || std::abs(x) > kMaxMagnitude)
+      fail(file, fmt::format("distortion_coefficients: {} is not finite", x));
+  d.resize(5, 0.0);
+  return {d[0], d[1], d[2], d[3], d[4]};
+}
+
+// The mount: version 1 keeps R_CW and the offset; version 2 EuRoC's T_BS, the camera's pose in
+// the body, at body yaw 0 (the open-loop UAVs' yaw), so R_CW = R_BS^T.
+void read_mount(const YAML::Node& n, const fs::path& file, int version, CameraInfo& c) {
+  if (version >= 2) {
+    Eigen::Matrix3d R_BS;
+    read_T_BS(n, file, R_BS, c.offset);
+    check_rotation(R_BS, file, "T_BS's rotation");
+    c.R_CW = R_BS.transpose();
+    return;
+  }
+  const auto r = numbers(n, file, "R_CW", 9);
+  const auto o = numbers(n, file, "offset", 3);
+  for (double x : o)
+    if (!std::isfinite(x) || std::abs(x) > kMaxMagnitude) fail(file, fmt::format("offset: {} is not finite", x));
+  for (int i = 0; i < 9; ++i) c.R_CW(i / 3, i % 3) = r[i];
+  check_rotation(c.R_CW, file, "R_CW");
+  c.offset = {o[0], o[1], o[2]};
+}
+
+int read_channels(const YAML::Node& n, const fs::path& file, int version) {
+  if (version < 2) {
+    const int channels = n["channels"] ? get<int>(n, file, "channels") : 3;
+    if (channels != 1 && channels != 3) fail(file, fmt::format("channels must be 1 or 3, got {}", channels));
+    return channels;
+  }
+  const auto enc = get<std::string>(n, file, "encoding");
+  if (enc == "mono8" || enc == "mono16") return 1;
+  if (enc == "rgb8") return 3;
+  fail(file, fmt::format("encoding '{}': expected mono8 or rgb8 (mono16 for depth)", enc));
+}
+
+CameraInfo read_camera(const fs::path& file, double rate_fallback, int version) {
   const YAML::Node n = load_yaml(file);
   const auto res = numbers(n, file, "resolution", 2);
   const auto k = numbers(n, file, "intrinsics", 4);
-  const auto d = numbers(n, file, "distortion_coefficients", 5);
-  const auto r = numbers(n, file, "R_CW", 9);
-  const auto o = numbers(n, file, "offset", 3);
   if (!(res[0] >= 1 && res[0] <= 16384 && res[1] >= 1 && res[1] <= 16384) || res[0] != std::floor(res[0]) ||
       res[1] != std::floor(res[1]))
     fail(file, fmt::format("resolution [{}, {}] must be whole numbers of pixels from 1 to 16384", res[0], res[1]));
@@ -158,21 +226,15 @@ CameraInfo read_camera(const fs::path& file, double rate_fallback) {
         std::isfinite(k[3])))
     fail(file, fmt::format("intrinsics [{}, {}, {}, {}]: fx and fy must be positive, all finite", k[0], k[1],
                            k[2], k[3]));
-  for (const auto& [key, v] : {std::pair{"distortion_coefficients", d}, std::pair{"offset", o}})
-    for (double x : v)
-      if (!std::isfinite(x) || std::abs(x) > kMaxMagnitude) fail(file, fmt::format("{}: {} is not finite", key, x));
+  if (version >= 2 && get<std::string>(n, file, "camera_model") != "pinhole")
+    fail(file, "camera_model: this reader knows pinhole");
   CameraInfo c;
-  c.camera = geometry::PinholeCamera(k[0], k[1], k[2], k[3], static_cast<int>(res[0]),
-                                     static_cast<int>(res[1]), {d[0], d[1], d[2], d[3], d[4]});
-  for (int i = 0; i < 9; ++i) c.R_CW(i / 3, i % 3) = r[i];
-  const double orth = (c.R_CW * c.R_CW.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  if (!(orth < 1e-6) || !(std::abs(c.R_CW.determinant() - 1) < 1e-6))
-    fail(file, "R_CW is not a rotation matrix (R R^T = I and det R = 1, to 1e-6)");
-  c.offset = {o[0], o[1], o[2]};
+  c.camera = geometry::PinholeCamera(k[0], k[1], k[2], k[3], static_cast<int>(res[0]), static_cast<int>(res[1]),
+                                     read_distortion(n, file, version));
+  read_mount(n, file, version, c);
   c.rate = n["rate_hz"] ? get<double>(n, file, "rate_hz") : rate_fallback;
   if (!(c.rate > 0 && c.rate <= 1000)) fail(file, fmt::format("rate_hz must be in (0, 1000], got {}", c.rate));
-  c.channels = n["channels"] ? get<int>(n, file, "channels") : 3;
-  if (c.channels != 1 && c.channels != 3) fail(file, fmt::format("channels must be 1 or 3, got {}", c.channels));
+  c.channels = read_channels(n, file, version);
   return c;
 }
 
@@ -200,19 +262,63 @@ std::vector<std::int64_t> read_frames(const fs::path& folder, const CameraInfo& 
   return out;
 }
 
-std::vector<PoseSample> read_poses(const fs::path& csv, bool velocity) {
+// A ground-truth file: a body's (version 1: 11 columns; version 2: EuRoC's 17, with the IMU's
+// biases) or a camera's (8 columns: version 1 q_CW, version 2 q_WC; held in memory as R_CW).
+enum class PoseFile { Body, Camera };
+
+std::vector<PoseSample> read_poses(const fs::path& csv, PoseFile kind, int version) {
+  const bool body = kind == PoseFile::Body;
   std::vector<PoseSample> out;
-  const auto rows = read_csv(csv, velocity ? 11 : 8);
+  const auto rows = read_csv(csv, body ? (version >= 2 ? 17 : 11) : 8);
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
+    const auto vec = [&](int c) { return Eigen::Vector3d(num(r[c], csv, i), num(r[c + 1], csv, i), num(r[c + 2], csv, i)); };
     PoseSample s;
     s.t_ns = stamp(r[0], csv, i);
     check_increasing(s.t_ns, out.empty() ? 0 : out.back().t_ns, out.empty(), csv, i);
-    s.p = {num(r[1], csv, i), num(r[2], csv, i), num(r[3], csv, i)};
+    s.p = vec(1);
     s.q_xyzw = {num(r[5], csv, i), num(r[6], csv, i), num(r[7], csv, i), num(r[4], csv, i)};
     if (std::abs(s.q_xyzw.norm() - 1) > 1e-3)
       fail(csv, fmt::format("data row {}: the quaternion has norm {}, not 1", i + 1, s.q_xyzw.norm()));
-    if (velocity) s.v = {num(r[8], csv, i), num(r[9], csv, i), num(r[10], csv, i)};
+    if (!body && version >= 2) s.q_xyzw.head<3>() = -s.q_xyzw.head<3>();  // q_WC to q_CW
+    if (body) s.v = vec(8);
+    if (body && version >= 2) {
+      s.b_w = vec(11);
+      s.b_a = vec(14);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+ImuInfo read_imu_info(const fs::path& file) {
+  const YAML::Node n = load_yaml(file);
+  ImuInfo info;
+  info.rate = get<double>(n, file, "rate_hz");
+  if (!(info.rate > 0 && info.rate <= 100000)) fail(file, fmt::format("rate_hz must be in (0, 100000], got {}", info.rate));
+  const std::pair<const char*, double*> keys[] = {
+      {"gyroscope_noise_density", &info.gyroscope_noise_density},
+      {"gyroscope_random_walk", &info.gyroscope_random_walk},
+      {"accelerometer_noise_density", &info.accelerometer_noise_density},
+      {"accelerometer_random_walk", &info.accelerometer_random_walk}};
+  for (const auto& [key, value] : keys) {
+    *value = get<double>(n, file, key);
+    if (!(*value >= 0 && std::isfinite(*value))) fail(file, fmt::format("{} must be >= 0, got {}", key, *value));
+  }
+  return info;
+}
+
+std::vector<ImuSample> read_imu(const fs::path& csv) {
+  std::vector<ImuSample> out;
+  const auto rows = read_csv(csv, 7);
+  out.reserve(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    ImuSample s;
+    s.t_ns = stamp(r[0], csv, i);
+    check_increasing(s.t_ns, out.empty() ? 0 : out.back().t_ns, out.empty(), csv, i);
+    s.w_S = {num(r[1], csv, i), num(r[2], csv, i), num(r[3], csv, i)};
+    s.a_S = {num(r[4], csv, i), num(r[5], csv, i), num(r[6], csv, i)};
     out.push_back(s);
   }
   return out;
@@ -252,10 +358,10 @@ const AgentData& Dataset::agent(const std::string& name) const {
 }
 
 fs::path Dataset::image_path(const std::string& a, std::int64_t t) const {
-  return root / a / "cam0" / "data" / fmt::format("{}.png", t);
+  return layout.sensor(root, a, "cam0") / "data" / fmt::format("{}.png", t);
 }
 fs::path Dataset::depth_path(const std::string& a, std::int64_t t) const {
-  return root / a / "depth0" / "data" / fmt::format("{}.png", t);
+  return layout.sensor(root, a, "depth0") / "data" / fmt::format("{}.png", t);
 }
 
 cv::Mat Dataset::load_image(const std::string& a, std::int64_t t) const {
@@ -275,74 +381,107 @@ cv::Mat Dataset::load_depth(const std::string& a, std::int64_t t) const {
   return m;
 }
 
-Dataset read_dataset(const fs::path& dir) {
-  Dataset ds;
-  ds.root = dir;
+namespace {
+
+DatasetInfo read_info(const fs::path& dir) {
   const fs::path yf = dir / "dataset.yaml";
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) fail(dir, "not a directory");
-  if (!fs::is_regular_file(yf, ec))
-    fail(yf, "missing: not a wingman dataset, or an unfinished one");
+  if (!fs::is_regular_file(yf, ec)) fail(yf, "missing: not a wingman dataset, or an unfinished one");
   const YAML::Node y = load_yaml(yf);
   if (!y.IsMap()) fail(yf, "expected a map");
   if (get<std::string>(y, yf, "format") != "wingman-dataset") fail(yf, "format is not 'wingman-dataset'");
-  ds.info.format_version = get<int>(y, yf, "format_version");
-  if (ds.info.format_version != kFormatVersion)
-    fail(yf, fmt::format("unknown format_version {} (this wingman reads version {})",
-                         ds.info.format_version, kFormatVersion));
-  ds.info.scenario = get<std::string>(y, yf, "scenario");
-  ds.info.variant = y["variant"] && !y["variant"].IsNull() ? get<std::string>(y, yf, "variant") : "";
-  ds.info.seed = get<std::uint64_t>(y, yf, "seed");
-  ds.info.software_version = get<std::string>(y, yf, "software_version");
-  ds.info.rate = get<double>(y, yf, "rate_hz");
-  if (!(ds.info.rate > 0 && ds.info.rate <= 1000))
-    fail(yf, fmt::format("rate_hz must be in (0, 1000], got {}", ds.info.rate));
-  ds.info.frames = get<int>(y, yf, "frames");
-  if (ds.info.frames < 0) fail(yf, fmt::format("frames must be >= 0, got {}", ds.info.frames));
-  ds.info.renderer = y["renderer"] ? get<std::string>(y, yf, "renderer") : "";
-  ds.info.agents = get<std::vector<std::string>>(y, yf, "agents");
-  check_agent_names(ds.info.agents, yf);
-  for (const auto& name : ds.info.agents) {
-    AgentData a;
-    a.name = name;
-    const fs::path ad = dir / name;
-    if (!fs::is_directory(ad, ec)) fail(ad, "missing agent folder (listed in dataset.yaml)");
-    a.groundtruth = read_poses(ad / "groundtruth" / "data.csv", true);
-    if (fs::exists(ad / "cam0", ec)) {
-      a.camera = read_camera(ad / "cam0" / "sensor.yaml", ds.info.rate);
-      // The depth frames are the colour frames' pixels: the same camera.
-      const CameraInfo depth_cam = read_camera(ad / "depth0" / "sensor.yaml", ds.info.rate);
-      if (depth_cam.camera.width() != a.camera->camera.width() ||
-          depth_cam.camera.height() != a.camera->camera.height() ||
-          depth_cam.camera.fx() != a.camera->camera.fx() || depth_cam.camera.fy() != a.camera->camera.fy() ||
-          depth_cam.camera.cx() != a.camera->camera.cx() || depth_cam.camera.cy() != a.camera->camera.cy())
-        fail(ad / "depth0" / "sensor.yaml", "its resolution or intrinsics differ from cam0/sensor.yaml");
-      a.frames = read_frames(ad / "cam0", *a.camera, false);
-      const auto depth = read_frames(ad / "depth0", *a.camera, true);
-      if (depth != a.frames)
-        fail(ad / "depth0" / "data.csv", "its time stamps differ from cam0/data.csv");
-      if (static_cast<int>(a.frames.size()) != ds.info.frames)
-        fail(ad / "cam0" / "data.csv", fmt::format("lists {} frames, dataset.yaml says {}",
-                                                   a.frames.size(), ds.info.frames));
-      a.camera_pose = read_poses(ad / "groundtruth" / "cam0.csv", false);
-      if (a.camera_pose.size() != a.frames.size())
-        fail(ad / "groundtruth" / "cam0.csv",
-             fmt::format("has {} poses for {} frames", a.camera_pose.size(), a.frames.size()));
-    }
-    if (fs::exists(ad / "gps0", ec)) {
-      const fs::path csv = ad / "gps0" / "data.csv";
-      const auto rows = read_csv(csv, 4);
-      for (std::size_t i = 0; i < rows.size(); ++i) {
-        const std::int64_t t = stamp(rows[i][0], csv, i);
-        check_increasing(t, a.gps.empty() ? 0 : a.gps.back().t_ns, a.gps.empty(), csv, i);
-        a.gps.push_back({t, {num(rows[i][1], csv, i), num(rows[i][2], csv, i), num(rows[i][3], csv, i)}});
-      }
-    }
-    if (fs::exists(ad / "altimeter0", ec)) a.altimeter = read_scalars(ad / "altimeter0" / "data.csv");
-    if (fs::exists(ad / "range0", ec)) a.range = read_scalars(ad / "range0" / "data.csv");
-    if (fs::exists(ad / "ahrs0", ec)) a.ahrs = read_scalars(ad / "ahrs0" / "data.csv");
-    ds.agents.push_back(std::move(a));
+  DatasetInfo info;
+  info.format_version = get<int>(y, yf, "format_version");
+  if (info.format_version != kFormatVersion && info.format_version != 1)
+    fail(yf, fmt::format("unknown format_version {} (this wingman reads versions 1 and {})", info.format_version,
+                         kFormatVersion));
+  info.scenario = get<std::string>(y, yf, "scenario");
+  info.variant = y["variant"] && !y["variant"].IsNull() ? get<std::string>(y, yf, "variant") : "";
+  info.seed = get<std::uint64_t>(y, yf, "seed");
+  info.software_version = get<std::string>(y, yf, "software_version");
+  info.rate = get<double>(y, yf, "rate_hz");
+  if (!(info.rate > 0 && info.rate <= 1000)) fail(yf, fmt::format("rate_hz must be in (0, 1000], got {}", info.rate));
+  info.frames = get<int>(y, yf, "frames");
+  if (info.frames < 0) fail(yf, fmt::format("frames must be >= 0, got {}", info.frames));
+  info.renderer = y["renderer"] ? get<std::string>(y, yf, "renderer") : "";
+  info.agents = get<std::vector<std::string>>(y, yf, "agents");
+  check_agent_names(info.agents, yf);
+  return info;
+}
+
+// A sensor folder an agent of this kind must have.
+fs::path required(const fs::path& folder, const std::string& why) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) fail(folder, fmt::format("missing sensor folder ({})", why));
+  return folder;
+}
+
+void read_camera_sensors(const Dataset& ds, AgentData& a) {
+  const Layout& l = ds.layout;
+  const int v = l.version;
+  const fs::path cam0 = l.sensor(ds.root, a.name, "cam0");
+  const fs::path depth0 = required(l.sensor(ds.root, a.name, "depth0"), "a camera's depth0 goes with its cam0");
+  a.camera = read_camera(cam0 / "sensor.yaml", ds.info.rate, v);
+  // The depth frames are the colour frames' pixels: the same camera.
+  const CameraInfo depth_cam = read_camera(depth0 / "sensor.yaml", ds.info.rate, v);
+  const auto& c = a.camera->camera;
+  const auto& d = depth_cam.camera;
+  if (d.width() != c.width() || d.height() != c.height() || d.fx() != c.fx() || d.fy() != c.fy() ||
+      d.cx() != c.cx() || d.cy() != c.cy())
+    fail(depth0 / "sensor.yaml", "its resolution or intrinsics differ from cam0/sensor.yaml");
+  a.frames = read_frames(cam0, *a.camera, false);
+  if (read_frames(depth0, *a.camera, true) != a.frames)
+    fail(depth0 / "data.csv", "its time stamps differ from cam0/data.csv");
+  if (static_cast<int>(a.frames.size()) != ds.info.frames)
+    fail(cam0 / "data.csv", fmt::format("lists {} frames, dataset.yaml says {}", a.frames.size(), ds.info.frames));
+  const fs::path poses = l.camera_pose_csv(ds.root, a.name);
+  if (v >= 2) required(poses.parent_path(), "the true camera poses of cam0's frames");
+  a.camera_pose = read_poses(poses, PoseFile::Camera, v);
+  if (a.camera_pose.size() != a.frames.size())
+    fail(poses, fmt::format("has {} poses for {} frames", a.camera_pose.size(), a.frames.size()));
+  if (v >= 2) {
+    const fs::path imu0 = required(l.sensor(ds.root, a.name, "imu0"), "every UAV carries an IMU");
+    a.imu_info = read_imu_info(imu0 / "sensor.yaml");
+    a.imu = read_imu(imu0 / "data.csv");
   }
+}
+
+AgentData read_agent(const Dataset& ds, const std::string& name) {
+  AgentData a;
+  a.name = name;
+  const Layout& l = ds.layout;
+  std::error_code ec;
+  if (!fs::is_directory(l.agent(ds.root, name), ec))
+    fail(l.agent(ds.root, name), "missing agent folder (listed in dataset.yaml)");
+  const fs::path gt = l.groundtruth_csv(ds.root, name);
+  required(gt.parent_path(), "every agent has its ground truth");
+  a.groundtruth = read_poses(gt, PoseFile::Body, l.version);
+  if (fs::exists(l.sensor(ds.root, name, "cam0"), ec)) read_camera_sensors(ds, a);
+  if (fs::exists(l.sensor(ds.root, name, "gps0"), ec)) {
+    const fs::path csv = l.sensor(ds.root, name, "gps0") / "data.csv";
+    const auto rows = read_csv(csv, 4);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const std::int64_t t = stamp(rows[i][0], csv, i);
+      check_increasing(t, a.gps.empty() ? 0 : a.gps.back().t_ns, a.gps.empty(), csv, i);
+      a.gps.push_back({t, {num(rows[i][1], csv, i), num(rows[i][2], csv, i), num(rows[i][3], csv, i)}});
+    }
+  }
+  for (auto [folder, samples] : {std::pair{"altimeter0", &a.altimeter}, std::pair{"range0", &a.range},
+                                 std::pair{"ahrs0", &a.ahrs}})
+    if (fs::exists(l.sensor(ds.root, name, folder), ec))
+      *samples = read_scalars(l.sensor(ds.root, name, folder) / "data.csv");
+  return a;
+}
+
+}  // namespace
+
+Dataset read_dataset(const fs::path& dir) {
+  Dataset ds;
+  ds.root = dir;
+  ds.info = read_info(dir);
+  ds.layout.version = ds.info.format_version;
+  for (const auto& name : ds.info.agents) ds.agents.push_back(read_agent(ds, name));
   return ds;
 }
 
@@ -400,7 +539,7 @@ void verify_frames(const Dataset& ds, const std::function<void(int, int)>& progr
       for (const bool depth : {false, true}) {
         const fs::path file = depth ? ds.depth_path(a.name, t) : ds.image_path(a.name, t);
         if (sums) {
-          const std::string rel = fmt::format("{}/{}/data/{}.png", a.name, depth ? "depth0" : "cam0", t);
+          const std::string rel = ds.layout.frame_relative(a.name, depth, t);
           const auto it = checksums.find(rel);
           if (it == checksums.end()) fail(file, fmt::format("not listed in {}", csv.string()));
           verify_checksum(file, it->second, buf);

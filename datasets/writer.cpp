@@ -105,6 +105,7 @@ struct DatasetWriter::Encoder {
 
 DatasetWriter::DatasetWriter(fs::path dir, DatasetInfo info, unsigned threads)
     : dir_(std::move(dir)), info_(std::move(info)) {
+  info_.format_version = kFormatVersion;  // the only layout written
   if (threads == 0) threads = std::clamp(std::thread::hardware_concurrency(), 1u, 8u);
   encoder_ = std::make_unique<Encoder>(threads);
 }
@@ -120,10 +121,10 @@ void DatasetWriter::add_agent(const std::string& name, const std::optional<Camer
   AgentData a;
   a.name = name;
   a.camera = camera;
-  fs::create_directories(dir_ / name / "groundtruth");
+  fs::create_directories(layout_.agent(dir_, name));
   if (camera) {
-    fs::create_directories(dir_ / name / "cam0" / "data");
-    fs::create_directories(dir_ / name / "depth0" / "data");
+    fs::create_directories(layout_.sensor(dir_, name, "cam0") / "data");
+    fs::create_directories(layout_.sensor(dir_, name, "depth0") / "data");
   }
   agents_.push_back(std::move(a));
 }
@@ -173,8 +174,8 @@ void DatasetWriter::write_frame(const std::string& agent, std::int64_t t_ns, con
   if (!a.camera) throw std::logic_error("dataset writer: agent '" + agent + "' has no camera");
   const std::string file = fmt::format("{}.png", t_ns);
   const bool gray = a.camera->channels == 1;
-  const fs::path colour_path = dir_ / agent / "cam0" / "data" / file;
-  const fs::path depth_path = dir_ / agent / "depth0" / "data" / file;
+  const fs::path colour_path = layout_.sensor(dir_, agent, "cam0") / "data" / file;
+  const fs::path depth_path = layout_.sensor(dir_, agent, "depth0") / "data" / file;
   // Converted here (cheap), encoded on a worker (costly); the job owns its images.
   cv::Mat out;
   cv::cvtColor(rgb, out, gray ? cv::COLOR_RGB2GRAY : cv::COLOR_RGB2BGR);
@@ -184,7 +185,8 @@ void DatasetWriter::write_frame(const std::string& agent, std::int64_t t_ns, con
   cv::Mat valid = (depth > 0) & (depth < 65.5355);
   depth.convertTo(mm, CV_16U, 1.0 / kDepthScale);
   mm.setTo(0, ~valid);
-  const std::string colour_rel = agent + "/cam0/data/" + file, depth_rel = agent + "/depth0/data/" + file;
+  const std::string colour_rel = layout_.frame_relative(agent, false, t_ns),
+                    depth_rel = layout_.frame_relative(agent, true, t_ns);
   encoder_->push([this, out, mm, colour_path, depth_path, colour_rel, depth_rel] {
     const FrameChecksum c = write_png(colour_path, out), d = write_png(depth_path, mm);
     std::lock_guard lock(checksums_mutex_);
@@ -203,82 +205,165 @@ void DatasetWriter::ahrs(const std::string& agent, const ScalarSample& s) { get(
 void DatasetWriter::imu_info(const std::string& agent, const ImuInfo& info) { get(agent).imu_info = info; }
 void DatasetWriter::imu(const std::string& agent, const ImuSample& s) { get(agent).imu.push_back(s); }
 
+namespace {
+
+std::string g(double x) { return fmt::format("{:.9g}", x + 0.0); }  // + 0.0: no "-0"
+
+// EuRoC's extrinsics block: T_BS, the sensor's pose in the body frame, a row-major 4x4.
+void emit_T_BS(YAML::Emitter& e, const Eigen::Matrix3d& R_BS, const Eigen::Vector3d& p_BS) {
+  std::vector<double> data;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) data.push_back(R_BS(i, j) + 0.0);
+    data.push_back(p_BS(i) + 0.0);
+  }
+  for (double x : {0.0, 0.0, 0.0, 1.0}) data.push_back(x);
+  e << YAML::Key << "T_BS" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "cols" << YAML::Value << 4 << YAML::Key << "rows" << YAML::Value << 4;
+  e << YAML::Key << "data" << YAML::Value;
+  seq(e, data);
+  e << YAML::EndMap;
+}
+
+// A sensor.yaml's opening keys, in EuRoC's order.
+void emit_sensor_head(YAML::Emitter& e, const char* type, const std::string& comment,
+                      const Eigen::Matrix3d& R_BS = Eigen::Matrix3d::Identity(),
+                      const Eigen::Vector3d& p_BS = Eigen::Vector3d::Zero()) {
+  e.SetDoublePrecision(15);
+  e << YAML::BeginMap;
+  e << YAML::Key << "sensor_type" << YAML::Value << type;
+  e << YAML::Key << "comment" << YAML::Value << comment;
+  emit_T_BS(e, R_BS, p_BS);
+}
+
+// cam0 or depth0: the camera's nominal mount (T_BS: the commanded attitude at body yaw 0, the
+// offset d) and its intrinsics. Radial-tangential takes four coefficients; a lens with k3 is
+// written as ROS's plumb_bob (k1, k2, p1, p2, k3).
+void write_camera_yaml(const fs::path& p, const CameraInfo& c, bool depth) {
+  YAML::Emitter e;
+  emit_sensor_head(e, depth ? "depth" : "camera",
+                   depth ? "metric depth along the optical axis of cam0, 16-bit PNG; value * depth_scale = metres, 0 = none"
+                         : "pinhole camera on a world-stabilised gimbal; pixel (0,0) is the centre of the top-left "
+                           "pixel; the true pose of every frame (gimbal error included) is in cam0_pose0",
+                   c.R_CW.transpose(), c.offset);
+  e << YAML::Key << "rate_hz" << YAML::Value << c.rate;
+  e << YAML::Key << "resolution" << YAML::Value;
+  seq(e, std::vector<int>{c.camera.width(), c.camera.height()});
+  e << YAML::Key << "camera_model" << YAML::Value << "pinhole";
+  e << YAML::Key << "intrinsics" << YAML::Value;
+  seq(e, std::vector<double>{c.camera.fx(), c.camera.fy(), c.camera.cx(), c.camera.cy()});
+  const auto& k = c.camera.distortion();
+  const bool radtan = k.k3 == 0;
+  e << YAML::Key << "distortion_model" << YAML::Value << (radtan ? "radial-tangential" : "plumb_bob");
+  e << YAML::Key << "distortion_coefficients" << YAML::Value;
+  seq(e, radtan ? std::vector<double>{k.k1, k.k2, k.p1, k.p2} : std::vector<double>{k.k1, k.k2, k.p1, k.p2, k.k3});
+  if (depth) {
+    e << YAML::Key << "depth_scale" << YAML::Value << kDepthScale;
+    e << YAML::Key << "encoding" << YAML::Value << "mono16";
+  } else {
+    e << YAML::Key << "encoding" << YAML::Value << (c.channels == 1 ? "mono8" : "rgb8");
+  }
+  e << YAML::EndMap;
+  write_yaml(p, e);
+}
+
+void write_plain_yaml(const fs::path& p, const char* type, const std::string& comment,
+                      const std::function<void(YAML::Emitter&)>& more = {}) {
+  YAML::Emitter e;
+  emit_sensor_head(e, type, comment);
+  if (more) more(e);
+  e << YAML::EndMap;
+  write_yaml(p, e);
+}
+
+void write_imu(const fs::path& folder, const AgentData& a) {
+  if (!a.imu_info) return;
+  const ImuInfo& n = *a.imu_info;
+  write_csv(folder / "data.csv", kImuHeader, a.imu.size(), [&](std::size_t i) {
+    const auto& s = a.imu[i];
+    return fmt::format("{},{},{},{},{},{},{}", s.t_ns, g(s.w_S.x()), g(s.w_S.y()), g(s.w_S.z()), g(s.a_S.x()),
+                       g(s.a_S.y()), g(s.a_S.z()));
+  });
+  write_plain_yaml(folder / "sensor.yaml", "imu",
+                   "simulated strapdown IMU at the body's origin, axes the body's; biases in "
+                   "state_groundtruth_estimate0",
+                   [&](YAML::Emitter& e) {
+                     e << YAML::Key << "rate_hz" << YAML::Value << n.rate;
+                     e << YAML::Key << "gyroscope_noise_density" << YAML::Value << n.gyroscope_noise_density;
+                     e << YAML::Key << "gyroscope_random_walk" << YAML::Value << n.gyroscope_random_walk;
+                     e << YAML::Key << "accelerometer_noise_density" << YAML::Value << n.accelerometer_noise_density;
+                     e << YAML::Key << "accelerometer_random_walk" << YAML::Value << n.accelerometer_random_walk;
+                   });
+}
+
+void write_poses(const fs::path& mav0, const AgentData& a) {
+  write_csv(mav0 / "state_groundtruth_estimate0" / "data.csv", kGroundTruthHeader, a.groundtruth.size(),
+            [&](std::size_t i) {
+              const auto& s = a.groundtruth[i];
+              return fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", s.t_ns, g(s.p.x()),
+                                 g(s.p.y()), g(s.p.z()), g(s.q_xyzw.w()), g(s.q_xyzw.x()), g(s.q_xyzw.y()),
+                                 g(s.q_xyzw.z()), g(s.v.x()), g(s.v.y()), g(s.v.z()), g(s.b_w.x()), g(s.b_w.y()),
+                                 g(s.b_w.z()), g(s.b_a.x()), g(s.b_a.y()), g(s.b_a.z()));
+            });
+  write_plain_yaml(mav0 / "state_groundtruth_estimate0" / "sensor.yaml", "groundtruth",
+                   "exact truth of the simulation: the body's pose in the world (p_WB, q_WB), its velocity "
+                   "in the world frame and the IMU's biases (0 without an IMU)");
+  if (a.camera_pose.empty()) return;
+  // Stored in memory as R_CW (world to camera); on disk as the camera's pose in the world, T_WC.
+  write_csv(mav0 / "cam0_pose0" / "data.csv", kCameraPoseHeader, a.camera_pose.size(), [&](std::size_t i) {
+    const auto& s = a.camera_pose[i];
+    return fmt::format("{},{},{},{},{},{},{},{}", s.t_ns, g(s.p.x()), g(s.p.y()), g(s.p.z()), g(s.q_xyzw.w()),
+                       g(-s.q_xyzw.x()), g(-s.q_xyzw.y()), g(-s.q_xyzw.z()));
+  });
+  write_plain_yaml(mav0 / "cam0_pose0" / "sensor.yaml", "pose",
+                   "true pose of cam0 in the world (T_WC, gimbal error included) at every frame");
+}
+
+void write_scalar(const fs::path& folder, const char* header, const std::vector<ScalarSample>& v,
+                  const char* comment) {
+  if (v.empty()) return;
+  write_csv(folder / "data.csv", header, v.size(),
+            [&](std::size_t i) { return fmt::format("{},{}", v[i].t_ns, g(v[i].value)); });
+  write_plain_yaml(folder / "sensor.yaml", "scalar", comment);
+}
+
+void write_sensors(const fs::path& mav0, const AgentData& a) {
+  if (!a.gps.empty()) {
+    write_csv(mav0 / "gps0" / "data.csv", "#timestamp [ns],p_W_x [m],p_W_y [m],p_W_z [m]", a.gps.size(),
+              [&](std::size_t i) {
+                const auto& s = a.gps[i];
+                return fmt::format("{},{},{},{}", s.t_ns, g(s.value.x()), g(s.value.y()), g(s.value.z()));
+              });
+    write_plain_yaml(mav0 / "gps0" / "sensor.yaml", "gps",
+                     "position fix in the world frame (local metres, z up), white noise (paper eq. 7)");
+  }
+  write_scalar(mav0 / "altimeter0", "#timestamp [ns],z [m]", a.altimeter,
+               "altitude of the body above the world's z = 0 (paper eq. 8)");
+  write_scalar(mav0 / "range0", "#timestamp [ns],range to lead [m]", a.range,
+               "distance from the body to the lead's reference point (paper eq. 9)");
+  write_scalar(mav0 / "ahrs0", "#timestamp [ns],yaw [rad]", a.ahrs, "yaw of the body about z, noisy");
+}
+
+void write_frames(const fs::path& mav0, const AgentData& a) {
+  for (const char* s : {"cam0", "depth0"})
+    write_csv(mav0 / s / "data.csv", kFramesHeader, a.frames.size(),
+              [&](std::size_t i) { return fmt::format("{},{}.png", a.frames[i], a.frames[i]); });
+  write_camera_yaml(mav0 / "cam0" / "sensor.yaml", *a.camera, false);
+  write_camera_yaml(mav0 / "depth0" / "sensor.yaml", *a.camera, true);
+}
+
+// One agent's folder (<agent>/mav0), everything but the images.
+void write_agent(const fs::path& mav0, const AgentData& a) {
+  write_poses(mav0, a);
+  write_sensors(mav0, a);
+  write_imu(mav0 / "imu0", a);
+  if (a.camera) write_frames(mav0, a);
+}
+
+}  // namespace
+
 void DatasetWriter::finish() {
   encoder_->drain();
-  const auto g = [](double x) { return fmt::format("{:.9g}", x + 0.0); };  // no "-0"
-  for (const AgentData& a : agents_) {
-    const fs::path d = dir_ / a.name;
-    write_csv(d / "groundtruth" / "data.csv",
-              "#timestamp [ns],p_x [m],p_y [m],p_z [m],q_w,q_x,q_y,q_z,v_x [m/s],v_y [m/s],v_z [m/s]",
-              a.groundtruth.size(), [&](std::size_t i) {
-                const auto& s = a.groundtruth[i];
-                return fmt::format("{},{},{},{},{},{},{},{},{},{},{}", s.t_ns, g(s.p.x()), g(s.p.y()),
-                                   g(s.p.z()), g(s.q_xyzw.w()), g(s.q_xyzw.x()), g(s.q_xyzw.y()),
-                                   g(s.q_xyzw.z()), g(s.v.x()), g(s.v.y()), g(s.v.z()));
-              });
-    if (!a.camera_pose.empty())
-      write_csv(d / "groundtruth" / "cam0.csv",
-                "#timestamp [ns],c_x [m],c_y [m],c_z [m],q_CW_w,q_CW_x,q_CW_y,q_CW_z",
-                a.camera_pose.size(), [&](std::size_t i) {
-                  const auto& s = a.camera_pose[i];
-                  return fmt::format("{},{},{},{},{},{},{},{}", s.t_ns, g(s.p.x()), g(s.p.y()),
-                                     g(s.p.z()), g(s.q_xyzw.w()), g(s.q_xyzw.x()),
-                                     g(s.q_xyzw.y()), g(s.q_xyzw.z()));
-                });
-    if (!a.gps.empty())
-      write_csv(d / "gps0" / "data.csv", "#timestamp [ns],x [m],y [m],z [m]", a.gps.size(),
-                [&](std::size_t i) {
-                  const auto& s = a.gps[i];
-                  return fmt::format("{},{},{},{}", s.t_ns, g(s.value.x()), g(s.value.y()), g(s.value.z()));
-                });
-    const auto scalar = [&](const char* folder, const char* header, const std::vector<ScalarSample>& v) {
-      if (v.empty()) return;
-      write_csv(d / folder / "data.csv", header, v.size(),
-                [&](std::size_t i) { return fmt::format("{},{}", v[i].t_ns, g(v[i].value)); });
-    };
-    scalar("altimeter0", "#timestamp [ns],z [m]", a.altimeter);
-    scalar("range0", "#timestamp [ns],range to lead [m]", a.range);
-    scalar("ahrs0", "#timestamp [ns],yaw [rad]", a.ahrs);
-    if (!a.camera) continue;
-    for (const char* s : {"cam0", "depth0"})
-      write_csv(d / s / "data.csv", "#timestamp [ns],filename", a.frames.size(),
-                [&](std::size_t i) { return fmt::format("{},{}.png", a.frames[i], a.frames[i]); });
-    const CameraInfo& c = *a.camera;
-    const auto& k = c.camera.distortion();
-    for (const bool depth : {false, true}) {
-      YAML::Emitter e;
-      e.SetDoublePrecision(15);
-      e << YAML::BeginMap;
-      e << YAML::Key << "sensor_type" << YAML::Value << (depth ? "depth" : "camera");
-      e << YAML::Key << "comment" << YAML::Value
-        << (depth ? "metric depth along the optical axis, 16-bit PNG, value * depth_scale = metres, 0 = none"
-                  : "pinhole, OpenCV pixel convention (pixel (0,0) is the centre of the top-left pixel)");
-      e << YAML::Key << "rate_hz" << YAML::Value << c.rate;
-      e << YAML::Key << "resolution" << YAML::Value;
-      seq(e, std::vector<int>{c.camera.width(), c.camera.height()});
-      e << YAML::Key << "camera_model" << YAML::Value << "pinhole";
-      e << YAML::Key << "intrinsics" << YAML::Value;
-      seq(e, std::vector<double>{c.camera.fx(), c.camera.fy(), c.camera.cx(), c.camera.cy()});
-      e << YAML::Key << "distortion_model" << YAML::Value << "radial-tangential";
-      e << YAML::Key << "distortion_coefficients" << YAML::Value;
-      seq(e, std::vector<double>{k.k1, k.k2, k.p1, k.p2, k.k3});
-      e << YAML::Key << "R_CW" << YAML::Value;
-      std::vector<double> r;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) r.push_back(c.R_CW(i, j));
-      seq(e, r);
-      e << YAML::Key << "offset" << YAML::Value;
-      seq(e, std::vector<double>{c.offset.x(), c.offset.y(), c.offset.z()});
-      if (depth) {
-        e << YAML::Key << "depth_scale" << YAML::Value << kDepthScale;
-        e << YAML::Key << "encoding" << YAML::Value << "png16";
-      } else {
-        e << YAML::Key << "channels" << YAML::Value << c.channels;
-      }
-      e << YAML::EndMap;
-      write_yaml(d / (depth ? "depth0" : "cam0") / "sensor.yaml", e);
-    }
-  }
+  for (const AgentData& a : agents_) write_agent(layout_.agent(dir_, a.name), a);
   std::vector<std::pair<std::string, FrameChecksum>> sums(checksums_.begin(), checksums_.end());
   write_csv(dir_ / kChecksumsFile, "#file,bytes,crc32", sums.size(), [&](std::size_t i) {
     return fmt::format("{},{},{:08x}", sums[i].first, sums[i].second.bytes, sums[i].second.crc32);

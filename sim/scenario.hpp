@@ -142,6 +142,19 @@ struct NoiseSpec {
     double accel_sigma_lead = 0, accel_sigma_uav = 0, accel_sigma_common = 0;  // m/s^2
     bool any() const { return accel_sigma_lead > 0 || accel_sigma_uav > 0 || accel_sigma_common > 0; }
   } motion;
+  // The IMU each UAV carries in a dataset (`wingman render`, imu0/): continuous-time white noise
+  // and bias random walk in Kalibr's units, defaults EuRoC's ADIS16448 figures; initial biases
+  // N(0, sigma^2) per axis. The estimator does not use an IMU; datasets carry it for other
+  // systems.
+  struct Imu {
+    double rate = 200;                                 // Hz
+    double gyroscope_noise_density = 1.6968e-4;        // rad/s/sqrt(Hz)
+    double gyroscope_random_walk = 1.9393e-5;          // rad/s^2/sqrt(Hz)
+    double accelerometer_noise_density = 2.0e-3;       // m/s^2/sqrt(Hz)
+    double accelerometer_random_walk = 3.0e-3;         // m/s^3/sqrt(Hz)
+    double gyroscope_initial_bias_sigma = 2e-3;        // rad/s
+    double accelerometer_initial_bias_sigma = 2e-2;    // m/s^2
+  } imu;
 
   template <class V>
   void visit(V& v) {
@@ -163,6 +176,15 @@ struct NoiseSpec {
       m("accel_sigma_lead", motion.accel_sigma_lead, geometry::in(0, 100));
       m("accel_sigma_uav", motion.accel_sigma_uav, geometry::in(0, 100));
       m("accel_sigma_common", motion.accel_sigma_common, geometry::in(0, 100));
+    });
+    v.section("imu", [&](auto& m) {
+      m("rate", imu.rate, geometry::in(1, 10000));
+      m("gyroscope_noise_density", imu.gyroscope_noise_density, geometry::in(0, 1));
+      m("gyroscope_random_walk", imu.gyroscope_random_walk, geometry::in(0, 1));
+      m("accelerometer_noise_density", imu.accelerometer_noise_density, geometry::in(0, 10));
+      m("accelerometer_random_walk", imu.accelerometer_random_walk, geometry::in(0, 10));
+      m("gyroscope_initial_bias_sigma", imu.gyroscope_initial_bias_sigma, geometry::in(0, 1));
+      m("accelerometer_initial_bias_sigma", imu.accelerometer_initial_bias_sigma, geometry::in(0, 10));
     });
   }
 };

@@ -18,11 +18,16 @@ KinematicState lemniscate(const LeadTrajectorySpec& p, double t) {
   k.velocity = {-a * w * s * (D + 2 * c * c) / (D * D),
                 a * w * (std::cos(2 * w * t) * D - 2 * s * s * c * c) / (D * D),
                 p.z_amplitude * p.z_omega * std::cos(p.z_omega * t)};
+  // The second derivative, simplified with s^2 + c^2 = 1 (checked against differences in the tests).
+  const double D3 = D * D * D;
+  k.acceleration = {-a * w * w * c * (3 * c * c * D - 4 * s * s * (3 - s * s)) / D3,
+                    -a * w * w * s * c * (10 - 6 * s * s) / D3,
+                    -p.z_amplitude * p.z_omega * p.z_omega * std::sin(p.z_omega * t)};
   return k;
 }
 
 KinematicState nominal_motion(const LeadTrajectorySpec& p, double t) {
-  if (p.type == "line") return {p.velocity * t, p.velocity};
+  if (p.type == "line") return {p.velocity * t, p.velocity, Eigen::Vector3d::Zero()};
   return lemniscate(p, t);
 }
 
@@ -63,6 +68,9 @@ KinematicState OpenLoopTruth::agent(std::size_t a, const Eigen::Vector3d& start,
   const double f = s - static_cast<double>(i);
   k.position += start - origin_ + ((1 - f) * w[i].position + f * w[i + 1].position);
   k.velocity += (1 - f) * w[i].velocity + f * w[i + 1].velocity;
+  // Within a step the velocity changes linearly: the step's drawn acceleration.
+  if (t >= 0 && t < scn_.dt() * static_cast<double>(w.size() - 1))
+    k.acceleration += (w[i + 1].velocity - w[i].velocity) / scn_.dt();
   return k;
 }
 

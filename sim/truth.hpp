@@ -16,9 +16,12 @@ namespace wingman::sim {
 
 struct KinematicState {
   Eigen::Vector3d position = Eigen::Vector3d::Zero(), velocity = Eigen::Vector3d::Zero();
+  // The curve's second derivative (an IMU's specific force comes from it); zero where a truth
+  // does not know it (the closed loop's discrete steps).
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
 };
 
-// eq. 66 and its time derivative, unshifted.
+// eq. 66 and its first two time derivatives, unshifted.
 KinematicState lemniscate(const LeadTrajectorySpec& spec, double t);
 // The curve the scenario names (lemniscate or line), unshifted.
 KinematicState nominal_motion(const LeadTrajectorySpec& spec, double t);

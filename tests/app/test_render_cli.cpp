@@ -70,7 +70,7 @@ TEST(RenderCli, WritesADatasetThatReadsBackAndMatchesADirectRender) {
   const render::Frame f = renderer.render(
       {s.uavs[1].camera.camera(), truth.camera_R_CW(1, t), truth.camera(1, t).position},
       sim::lead_pose(truth, t, s.world));
-  EXPECT_EQ(cv::norm(ds.load_image("uav2", 100000000), f.rgb, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(ds.load_image("uav2", 100000000), f.gray(), cv::NORM_INF), 0);  // grey by default
   EXPECT_LT((ds.agent("uav2").camera_pose[1].p - truth.camera(1, t).position).norm(), 1e-6);
 }
 
@@ -123,7 +123,7 @@ TEST(RenderCli, SlamRefusesADatasetThatContradictsItsScenarioOrIsDamaged) {
          replace_once(t, "width: 200, height: 200}}\n  - {name: uav2", "width: 100, height: 100}}\n  - {name: uav2");
          write_file(d / "scenario.yaml", t);
        },
-       "uav1/cam0/sensor.yaml: the camera (200x200"},
+       "uav1/mav0/cam0/sensor.yaml: the camera (200x200"},
       {[](const fs::path& d) {
          std::string t = read_file(d / "dataset.yaml");
          replace_once(t, "agents: [lead, uav1, uav2]", "agents: [lead, uav1]");
@@ -131,12 +131,20 @@ TEST(RenderCli, SlamRefusesADatasetThatContradictsItsScenarioOrIsDamaged) {
        },
        "dataset.yaml: agents: no 'uav2'"},
       {[](const fs::path& d) {
-         const fs::path f = d / "uav2" / "cam0" / "data" / "200000000.png";
+         const fs::path f = d / "uav2" / "mav0" / "cam0" / "data" / "200000000.png";
          std::string b = read_file(f);
          b[b.size() - 100] ^= 0x10;
          write_file(f, b);
        },
-       "uav2/cam0/data/200000000.png: CRC-32"},
+       "uav2/mav0/cam0/data/200000000.png: CRC-32"},
+      {[](const fs::path& d) { fs::remove_all(d / "uav1" / "mav0" / "imu0"); },
+       "uav1/mav0/imu0: missing sensor folder (every UAV carries an IMU)"},
+      {[](const fs::path& d) {  // a malformed IMU row
+         std::string t = read_file(d / "uav2" / "mav0" / "imu0" / "data.csv");
+         replace_once(t, "\n5000000,", "\n5000000,x,");
+         write_file(d / "uav2" / "mav0" / "imu0" / "data.csv", t);
+       },
+       "uav2/mav0/imu0/data.csv: line 3: expected 7 columns, got 8"},
   };
   for (const Case& c : cases) {
     const fs::path copy = tmp / "copy";
@@ -171,7 +179,7 @@ TEST(RenderCli, InterruptLeavesNoDatasetBehind) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     for (const auto& e : fs::directory_iterator(tmp.path()))
       if (e.path().filename().string().rfind("ds.partial", 0) == 0 &&
-          fs::exists(e.path() / "uav1" / "cam0" / "data" / "100000000.png"))
+          fs::exists(e.path() / "uav1" / "mav0" / "cam0" / "data" / "100000000.png"))
         writing = true;
   }
   kill(pid, SIGINT);

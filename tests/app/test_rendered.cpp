@@ -250,7 +250,7 @@ TEST(RenderedPipeline, SlamAndBenchFrontendReplayARenderedDataset) {
   EXPECT_THAT(r.output, ::testing::ContainsRegex("\ngftt_orb +[0-9.]+ +[0-9.]+ +[0-9.]+%"));
 
   // A frame gone from the dataset: an error naming it, exit 2, no results.
-  fs::remove(ds / "uav2" / "cam0" / "data" / "100000000.png");
+  fs::remove(ds / "uav2" / "mav0" / "cam0" / "data" / "100000000.png");
   r = run_wingman({"slam", ds.string(), "--no-plots", "--quiet", "--out", (dir / "res2").string()},
                   dir.path());
   EXPECT_EQ(r.exit_code, 2) << r.output;

@@ -31,12 +31,19 @@ struct TempDir {
   }
 };
 
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
 struct Written {
   std::vector<cv::Mat> rgb, depth;
 };
 
-// Two agents: the lead (GPS) and one UAV with a 64 x 48 camera, three frames.
-Written write_small(const fs::path& dir, int channels = 3) {
+// Two agents: the lead (GPS) and one UAV with a 64 x 48 camera, three frames and an IMU.
+Written write_small(const fs::path& dir, int channels = 3, double k3 = 0) {
   DatasetInfo info;
   info.scenario = "unit";
   info.seed = 42;
@@ -46,11 +53,13 @@ Written write_small(const fs::path& dir, int channels = 3) {
   DatasetWriter w(dir, info);
   w.add_agent("lead", std::nullopt);
   CameraInfo cam;
-  cam.camera = geometry::PinholeCamera(40, 41, 31.5, 23.5, 64, 48, {-0.1, 0.01, 0.001, 0, 0});
+  cam.camera = geometry::PinholeCamera(40, 41, 31.5, 23.5, 64, 48, {-0.1, 0.01, 0.001, 0, k3});
   cam.R_CW << 1, 0, 0, 0, -1, 0, 0, 0, -1;
   cam.offset = {0.1, 0, -0.05};
   cam.channels = channels;
   w.add_agent("uav1", cam);
+  w.imu_info("uav1", {200, 1e-4, 2e-5, 2e-3, 3e-3});
+  for (int i = 0; i <= 40; ++i) w.imu("uav1", {step_ns(i, 200), {0.001 * i, 0, -0.5}, {0.25, 0, 9.75}});
   Written out;
   cv::RNG rng(7);
   for (int k = 0; k < 3; ++k) {
@@ -64,7 +73,7 @@ Written write_small(const fs::path& dir, int channels = 3) {
     out.rgb.push_back(rgb);
     out.depth.push_back(depth);
     w.ground_truth("lead", {t, {1.0 * k, 2, 0}, {0, 0, 0.3826834, 0.9238795}, {1, 0, 0}});
-    w.ground_truth("uav1", {t, {1.0 * k, 2, 15}, {0, 0, 0, 1}, {1, 0, 0}});
+    w.ground_truth("uav1", {t, {1.0 * k, 2, 15}, {0, 0, 0, 1}, {1, 0, 0}, {0.001, 0.002, 0.003}, {0.125, 0, -0.25}});
     w.camera_pose("uav1", {t, {1.0 * k + 0.1, 2, 14.95}, {1, 0, 0, 0}, {}});
     w.gps("lead", {t, {1.0 * k + 0.5, 2.25, -0.125}});
     w.altimeter("uav1", {t, 15.25});
@@ -112,6 +121,33 @@ TEST(Dataset, RoundTrip) {
   EXPECT_DOUBLE_EQ(u.range[0].value, 15.5);
   EXPECT_DOUBLE_EQ(u.ahrs[0].value, 0.0625);
   EXPECT_DOUBLE_EQ(u.camera_pose[0].q_xyzw.x(), 1);
+  ASSERT_TRUE(u.imu_info);
+  EXPECT_DOUBLE_EQ(u.imu_info->rate, 200);
+  EXPECT_DOUBLE_EQ(u.imu_info->accelerometer_random_walk, 3e-3);
+  ASSERT_EQ(u.imu.size(), 41u);
+  EXPECT_EQ(u.imu[40].t_ns, 200000000);
+  EXPECT_DOUBLE_EQ(u.imu[40].w_S.x(), 0.04);
+  EXPECT_DOUBLE_EQ(u.imu[3].a_S.z(), 9.75);
+  EXPECT_DOUBLE_EQ(u.groundtruth[1].b_w.z(), 0.003);
+  EXPECT_DOUBLE_EQ(u.groundtruth[1].b_a.z(), -0.25);
+  EXPECT_FALSE(ds.agent("lead").imu_info);
+}
+
+// EuRoC's radial-tangential model takes k1, k2, p1, p2; a lens with k3 is written as plumb_bob.
+TEST(Dataset, DistortionIsWrittenWithTheCountItsModelTakes) {
+  TempDir a, b;
+  write_small(a.path);
+  write_small(b.path, 3, 0.002);
+  const std::string radtan = slurp(a.path / "uav1" / "mav0" / "cam0" / "sensor.yaml");
+  EXPECT_NE(radtan.find("distortion_model: radial-tangential\ndistortion_coefficients: [-0.1, 0.01, 0.001, 0]\n"),
+            std::string::npos) << radtan;
+  const std::string bob = slurp(b.path / "uav1" / "mav0" / "cam0" / "sensor.yaml");
+  EXPECT_NE(bob.find("distortion_model: plumb_bob\ndistortion_coefficients: [-0.1, 0.01, 0.001, 0, 0.002]\n"),
+            std::string::npos) << bob;
+  EXPECT_DOUBLE_EQ(read_dataset(b.path).agent("uav1").camera->camera.distortion().k3, 0.002);
+  EXPECT_DOUBLE_EQ(read_dataset(a.path).agent("uav1").camera->camera.distortion().k3, 0);
+  // T_BS: the nominal mount, R_BS = R_CW^T and the offset.
+  EXPECT_NE(radtan.find("data: [1, 0, 0, 0.1, 0, -1, 0, 0, 0, 0, -1, -0.05, 0, 0, 0, 1]"), std::string::npos) << radtan;
 }
 
 TEST(Dataset, GrayFramesRoundTrip) {
@@ -133,7 +169,7 @@ std::string error_of(const fs::path& dir) {
 TEST(Dataset, MissingFrameNamesTheFile) {
   TempDir tmp;
   write_small(tmp.path);
-  const fs::path f = tmp.path / "uav1" / "cam0" / "data" / "100000000.png";
+  const fs::path f = tmp.path / "uav1" / "mav0" / "cam0" / "data" / "100000000.png";
   fs::remove(f);
   const std::string e = error_of(tmp.path);
   EXPECT_NE(e.find(f.string()), std::string::npos) << e;
@@ -143,7 +179,7 @@ TEST(Dataset, MissingFrameNamesTheFile) {
 TEST(Dataset, WrongImageSizeNamesTheFile) {
   TempDir tmp;
   write_small(tmp.path);
-  const fs::path f = tmp.path / "uav1" / "depth0" / "data" / "0.png";
+  const fs::path f = tmp.path / "uav1" / "mav0" / "depth0" / "data" / "0.png";
   cv::imwrite(f.string(), cv::Mat(10, 12, CV_16U, cv::Scalar(1000)));
   const std::string e = error_of(tmp.path);
   EXPECT_NE(e.find(f.string()), std::string::npos) << e;
@@ -158,7 +194,7 @@ TEST(Dataset, UnknownFormatVersionNamesTheFile) {
   std::stringstream s;
   s << in.rdbuf();
   std::string text = s.str();
-  text.replace(text.find("format_version: 1"), 17, "format_version: 7");
+  text.replace(text.find("format_version: 2"), 17, "format_version: 7");
   std::ofstream(y) << text;
   const std::string e = error_of(tmp.path);
   EXPECT_NE(e.find(y.string()), std::string::npos) << e;
@@ -176,7 +212,7 @@ TEST(Dataset, UnfinishedDirectoryIsNotADataset) {
 TEST(Dataset, CorruptCsvRowNamesTheFileAndLine) {
   TempDir tmp;
   write_small(tmp.path);
-  const fs::path csv = tmp.path / "uav1" / "altimeter0" / "data.csv";
+  const fs::path csv = tmp.path / "uav1" / "mav0" / "altimeter0" / "data.csv";
   std::ofstream(csv, std::ios::app) << "300000000,abc\n";
   const std::string e = error_of(tmp.path);
   EXPECT_NE(e.find(csv.string()), std::string::npos) << e;
@@ -191,7 +227,7 @@ TEST(Dataset, AnImageThatCannotBeWrittenFailsTheWriterNamingIt) {
   CameraInfo cam;
   cam.camera = geometry::PinholeCamera(40, 40, 31.5, 23.5, 64, 48);
   w.add_agent("uav1", cam);
-  fs::remove_all(tmp.path / "uav1" / "cam0" / "data");  // the encoder cannot write there
+  fs::remove_all(tmp.path / "uav1" / "mav0" / "cam0" / "data");  // the encoder cannot write there
   try {
     for (int k = 0; k < 50; ++k)
       w.write_frame("uav1", step_ns(k, 10), cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(9)),
@@ -205,18 +241,23 @@ TEST(Dataset, AnImageThatCannotBeWrittenFailsTheWriterNamingIt) {
   EXPECT_FALSE(fs::exists(tmp.path / "dataset.yaml"));
 }
 
+// A UAV of a version-2 dataset without one of its sensors: the reader names the missing folder.
+TEST(Dataset, AMissingSensorFolderIsNamed) {
+  for (const char* sensor : {"imu0", "depth0", "cam0_pose0", "state_groundtruth_estimate0"}) {
+    TempDir tmp;
+    write_small(tmp.path);
+    fs::remove_all(tmp.path / "uav1" / "mav0" / sensor);
+    const std::string e = error_of(tmp.path);
+    EXPECT_NE(e.find((tmp.path / "uav1" / "mav0" / sensor).string() + ": missing sensor folder"), std::string::npos)
+        << sensor << ": " << e;
+  }
+}
+
 }  // namespace
 }  // namespace wingman::datasets
 
 namespace wingman::datasets {
 namespace {
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // Replaces the first `from` in the file by `to` (which must be there).
 void patch(const fs::path& p, const std::string& from, const std::string& to) {
@@ -241,10 +282,10 @@ TEST(Dataset, WriterRecordsEveryFramesSizeAndChecksum) {
   write_small(tmp.path);
   const std::string sums = slurp(tmp.path / kChecksumsFile);
   EXPECT_EQ(sums.rfind("#file,bytes,crc32\n", 0), 0u);
-  const std::string frame = slurp(tmp.path / "uav1" / "cam0" / "data" / "100000000.png");
+  const std::string frame = slurp(tmp.path / "uav1" / "mav0" / "cam0" / "data" / "100000000.png");
   const auto crc = crc32_of(reinterpret_cast<const unsigned char*>(frame.data()), frame.size());
   char line[128];
-  std::snprintf(line, sizeof line, "uav1/cam0/data/100000000.png,%zu,%08x\n", frame.size(), crc);
+  std::snprintf(line, sizeof line, "uav1/mav0/cam0/data/100000000.png,%zu,%08x\n", frame.size(), crc);
   EXPECT_NE(sums.find(line), std::string::npos) << sums;
   EXPECT_EQ(verify_error(tmp.path), "no error");
   int calls = 0;
@@ -259,7 +300,7 @@ TEST(Dataset, WriterRecordsEveryFramesSizeAndChecksum) {
 TEST(Dataset, AFrameWithAValidHeaderAndABrokenBodyIsFoundBeforeReplay) {
   TempDir tmp;
   write_small(tmp.path);
-  const fs::path f = tmp.path / "uav1" / "cam0" / "data" / "0.png";  // frame 0 too
+  const fs::path f = tmp.path / "uav1" / "mav0" / "cam0" / "data" / "0.png";  // frame 0 too
   std::string bytes = slurp(f);
   bytes[bytes.size() / 2] ^= 0x5a;
   std::ofstream(f, std::ios::binary | std::ios::trunc) << bytes;
@@ -280,17 +321,24 @@ TEST(Dataset, ValuesOutOfRangeAreRefusedNamingFileAndRow) {
     const char* says;
   };
   const std::vector<Case> cases = {
-      {"uav1/cam0/sensor.yaml", "intrinsics: [40", "intrinsics: [0", "fx and fy must be positive"},
-      {"uav1/cam0/sensor.yaml", "intrinsics: [40", "intrinsics: [.nan", "fx and fy must be positive"},
-      {"uav1/cam0/sensor.yaml", "R_CW: [1", "R_CW: [0", "R_CW is not a rotation matrix"},
-      {"uav1/cam0/sensor.yaml", "rate_hz: 10", "rate_hz: -10", "rate_hz must be in (0, 1000]"},
+      {"uav1/mav0/cam0/sensor.yaml", "intrinsics: [40", "intrinsics: [0", "fx and fy must be positive"},
+      {"uav1/mav0/cam0/sensor.yaml", "intrinsics: [40", "intrinsics: [.nan", "fx and fy must be positive"},
+      {"uav1/mav0/cam0/sensor.yaml", "data: [1", "data: [0", "T_BS's rotation is not a rotation matrix"},
+      {"uav1/mav0/cam0/sensor.yaml", "0, 0, 0, 1]", "0, 0, 1, 1]", "T_BS.data: the last row must be 0 0 0 1"},
+      {"uav1/mav0/cam0/sensor.yaml", "rate_hz: 10", "rate_hz: -10", "rate_hz must be in (0, 1000]"},
+      {"uav1/mav0/cam0/sensor.yaml", "0.001, 0]", "0.001, 0, 0]", "key 'distortion_coefficients' must have 4 numbers"},
+      {"uav1/mav0/cam0/sensor.yaml", "encoding: rgb8", "encoding: bgr16", "encoding 'bgr16'"},
+      {"uav1/mav0/imu0/sensor.yaml", "gyroscope_noise_density: 0.0001", "gyroscope_noise_density: -1",
+       "gyroscope_noise_density must be >= 0"},
+      {"uav1/mav0/imu0/data.csv", "5000000,", "5000000,x,", "line 3: expected 7 columns, got 8"},
       {"dataset.yaml", "rate_hz: 10", "rate_hz: -10", "rate_hz must be in (0, 1000]"},
       {"dataset.yaml", "agents: [lead, uav1]", "agents: [lead, ../uav1]", "is not an agent name"},
       {"dataset.yaml", "agents: [lead, uav1]", "agents: [lead, uav1, uav1]", "listed twice"},
-      {"lead/gps0/data.csv", "100000000,1.5", "100000000,nan", "data row 2: nan is not a finite value"},
-      {"lead/gps0/data.csv", "100000000,1.5", "100000000,1e308", "data row 2: 1e308 is not a finite value"},
-      {"uav1/altimeter0/data.csv", "200000000,", "000000001,", "data row 3: time stamps must increase"},
-      {"lead/groundtruth/data.csv", "0.9238795", "0.5", "the quaternion has norm"},
+      {"lead/mav0/gps0/data.csv", "100000000,1.5", "100000000,nan", "data row 2: nan is not a finite value"},
+      {"lead/mav0/gps0/data.csv", "100000000,1.5", "100000000,1e308", "data row 2: 1e308 is not a finite value"},
+      {"uav1/mav0/altimeter0/data.csv", "200000000,", "000000001,", "data row 3: time stamps must increase"},
+      {"lead/mav0/state_groundtruth_estimate0/data.csv", "0.9238795", "0.5", "the quaternion has norm"},
+      {"uav1/mav0/state_groundtruth_estimate0/data.csv", ",-0.25\n", "\n", "expected 17 columns, got 16"},
   };
   for (const Case& c : cases) {
     TempDir tmp;
