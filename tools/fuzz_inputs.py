@@ -504,7 +504,7 @@ def yaml_edit(rng, p: Path, values: dict, root: Path) -> str:
 
 DATASET_VALUES = {
     "format": ["other", "''"],
-    "format_version": ["0", "2", "999", "-1", "nan", "1.5"],
+    "format_version": ["0", "1", "3", "999", "-1", "nan", "1.5"],
     "rate_hz": ["0", "-10", "nan", ".inf", "1e-300", "1e308"],
     "frames": ["0", "1", "-1", "1000000000", "3", "5"],
     "seed": ["-1", str(2**64), "nan", "abc"],
@@ -519,11 +519,15 @@ SENSOR_VALUES = {
     "resolution": ["[999, 1000]", "[1000, 999]", "[0, 0]", "[-1000, 1000]", "[1e308, 1000]",
                    "[2147483648, 1000]", "[1000]"],
     "rate_hz": ["-10", "0", "nan", "1e-300"],
-    "distortion_coefficients": ["[.nan, 0, 0, 0, 0]", "[1e308, 0, 0, 0, 0]", "[0, 0, 0, 0]"],
-    "R_CW": ["[0, 0, 0, 0, 0, 0, 0, 0, 0]", "[.nan, 0, 0, 0, 1, 0, 0, 0, 1]",
-             "[1, 0, 0, 0, 1, 0, 0, 0]"],
-    "offset": ["[.nan, 0, 0]", "[1e308, 0, 0]"],
-    "channels": ["0", "2", "4", "-1", "7"],
+    "distortion_coefficients": ["[.nan, 0, 0, 0]", "[1e308, 0, 0, 0]", "[0, 0, 0, 0, 0]", "[0, 0, 0]"],
+    "distortion_model": ["plumb_bob", "equidistant", "''"],
+    "camera_model": ["omni", "''"],
+    "T_BS": ["{cols: 4, rows: 4, data: [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1]}",
+             "{cols: 4, rows: 4, data: [.nan, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]}",
+             "{cols: 3, rows: 4, data: [1, 0, 0, 0, 1, 0, 0, 0, 1]}", "[1, 0, 0]"],
+    "encoding": ["bgr8", "mono16", "rgb8", "''"],
+    "gyroscope_noise_density": ["-1", "nan", "1e308"],
+    "accelerometer_random_walk": ["-1", "nan"],
 }
 
 
