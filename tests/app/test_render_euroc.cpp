@@ -17,7 +17,7 @@ const fs::path kPython = "/usr/bin/python3";  // Debian's, with python3-yaml (se
 const fs::path kLoader = kSourceDir / "tests" / "datasets" / "euroc_loader.py";
 
 std::string small_scenario(double duration) {
-  const std::string cam = "camera: {fx: 40.02, fy: 40.02, cx: 99.5, cy: 99.5, width: 200, height: 200}";
+  const std::string cam = "camera: {fx: 160, fy: 160, cx: 99.5, cy: 99.5, width: 200, height: 200}";
   std::string s = "name: small\nrate: 10\nduration: ";
   s += std::to_string(duration);
   s += "\nnoise: {motion: {accel_sigma_lead: 0.1, accel_sigma_uav: 0.1}}\nuavs:\n";
@@ -26,16 +26,38 @@ std::string small_scenario(double duration) {
   return s;
 }
 
-// Renders the small scenario into tmp/ds (extra arguments appended); ends the test without GL.
-#define RENDER_OR_END(tmp, duration, ...)                                                               \
-  do {                                                                                                  \
-    write_file((tmp) / "small.yaml", small_scenario(duration));                                        \
-    const auto r = run_wingman({"render", ((tmp) / "small.yaml").string(), "--out", ((tmp) / "ds").string(), \
-                                "-q", ##__VA_ARGS__},                                                   \
-                               (tmp).path());                                                           \
-    if (r.exit_code != 0 && r.output.find("GL") != std::string::npos) WINGMAN_NO_GL_CONTEXT(r.output);  \
-    ASSERT_EQ(r.exit_code, 0) << r.output;                                                             \
-  } while (0)
+// Renders the small scenario into dir/ds (extra arguments appended).
+RunResult render_small(const fs::path& dir, double duration, const std::vector<std::string>& extra = {}) {
+  write_file(dir / "small.yaml", small_scenario(duration));
+  std::vector<std::string> args = {"render", (dir / "small.yaml").string(), "--out", (dir / "ds").string(), "-q"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return run_wingman(args, dir);
+}
+
+// One 4 s dataset for the suite (rendering costs most of these tests' time); each test works on
+// its own copy.
+class RenderEuroc : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    shared_ = new TempDir;
+    const auto r = render_small(shared_->path(), 4.0);
+    render_output_ = r.output;
+    rendered_ = r.exit_code == 0;
+  }
+  static void TearDownTestSuite() {
+    delete shared_;
+    shared_ = nullptr;
+  }
+  void SetUp() override {
+    if (!rendered_ && render_output_.find("GL") != std::string::npos) WINGMAN_NO_GL_CONTEXT(render_output_);
+    ASSERT_TRUE(rendered_) << render_output_;
+    fs::copy(shared_->path() / "ds", tmp_ / "ds", fs::copy_options::recursive);
+  }
+  static inline TempDir* shared_ = nullptr;
+  static inline bool rendered_ = false;
+  static inline std::string render_output_;
+  TempDir tmp_;
+};
 
 RunResult run_script(const std::vector<std::string>& args, const fs::path& dir) {
   const fs::path log = dir / "script-output.txt";
@@ -49,9 +71,8 @@ RunResult run_script(const std::vector<std::string>& args, const fs::path& dir) 
   return r;
 }
 
-TEST(RenderEuroc, AnEurocLoaderReadsEveryUavAndItsImuReachesTheGroundTruthVelocity) {
-  TempDir tmp;
-  RENDER_OR_END(tmp, 4.0);
+TEST_F(RenderEuroc, AnEurocLoaderReadsEveryUavAndItsImuReachesTheGroundTruthVelocity) {
+  const TempDir& tmp = tmp_;
   for (const char* uav : {"uav1", "uav2"}) {
     const auto r = run_script({kPython.string(), kLoader.string(), (tmp / "ds" / uav / "mav0").string(),
                                "--integrate", "4"},
@@ -66,9 +87,8 @@ TEST(RenderEuroc, AnEurocLoaderReadsEveryUavAndItsImuReachesTheGroundTruthVeloci
 
 // The loader can fail: a ground truth short of EuRoC's 17 columns, and an IMU that disagrees
 // with the truth (its accelerometer's x shifted by 0.5 m/s^2), are refused.
-TEST(RenderEuroc, TheEurocLoaderRefusesAWrongGroundTruthOrImu) {
-  TempDir tmp;
-  RENDER_OR_END(tmp, 2.0);
+TEST_F(RenderEuroc, TheEurocLoaderRefusesAWrongGroundTruthOrImu) {
+  const TempDir& tmp = tmp_;
   const fs::path mav0 = tmp / "ds" / "uav1" / "mav0";
   const fs::path imu = mav0 / "imu0" / "data.csv";
   std::string text = read_file(imu), shifted;
@@ -84,7 +104,7 @@ TEST(RenderEuroc, TheEurocLoaderRefusesAWrongGroundTruthOrImu) {
     shifted += f[0] + "," + f[1] + "," + f[2] + "," + f[3] + "," + f[4] + "," + f[5] + "," + f[6] + "\n";
   }
   write_file(imu, shifted);
-  auto r = run_script({kPython.string(), kLoader.string(), mav0.string(), "--integrate", "2"}, tmp.path());
+  auto r = run_script({kPython.string(), kLoader.string(), mav0.string(), "--integrate", "4"}, tmp.path());
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_THAT(r.output, ::testing::HasSubstr("leaves the ground-truth velocity"));
 
@@ -98,15 +118,15 @@ TEST(RenderEuroc, TheEurocLoaderRefusesAWrongGroundTruthOrImu) {
   EXPECT_THAT(r.output, ::testing::HasSubstr("16 columns, EuRoC has 17"));
 }
 
-TEST(RenderEuroc, FramesAreGreyByDefaultAndRgbWhenAsked) {
-  TempDir tmp;
-  RENDER_OR_END(tmp, 0.2);
+TEST_F(RenderEuroc, FramesAreGreyByDefaultAndRgbWhenAsked) {
+  const TempDir& tmp = tmp_;
   datasets::Dataset ds = datasets::read_dataset(tmp / "ds");
   EXPECT_EQ(ds.agent("uav1").camera->channels, 1);
   EXPECT_EQ(ds.load_image("uav1", 0).channels(), 1);
   EXPECT_THAT(read_file(tmp / "ds" / "uav1" / "mav0" / "cam0" / "sensor.yaml"), ::testing::HasSubstr("encoding: mono8"));
   fs::remove_all(tmp / "ds");
-  RENDER_OR_END(tmp, 0.2, "--rgb");
+  const auto rgb = render_small(tmp.path(), 0.2, {"--rgb"});
+  ASSERT_EQ(rgb.exit_code, 0) << rgb.output;
   ds = datasets::read_dataset(tmp / "ds");
   EXPECT_EQ(ds.agent("uav1").camera->channels, 3);
   EXPECT_EQ(ds.load_image("uav1", 0).channels(), 3);
@@ -117,9 +137,8 @@ TEST(RenderEuroc, FramesAreGreyByDefaultAndRgbWhenAsked) {
   EXPECT_FALSE(fs::exists(tmp / "x"));
 }
 
-TEST(RenderEuroc, SlamReadsTheFormerLayoutWithIdenticalResults) {
-  TempDir tmp;
-  RENDER_OR_END(tmp, 1.0);
+TEST_F(RenderEuroc, SlamReadsTheFormerLayoutWithIdenticalResults) {
+  const TempDir& tmp = tmp_;
   fs::copy(tmp / "ds", tmp / "v1", fs::copy_options::recursive);
   const fs::path convert = kSourceDir / "tests" / "datasets" / "to_format_version_1.py";
   auto r = run_script({kPython.string(), convert.string(), (tmp / "v1").string()}, tmp.path());
