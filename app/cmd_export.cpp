@@ -84,7 +84,7 @@ int export_command(const ExportOptions& o) {
   options.compression = kCompression.at(o.compression);
   options.progress = [&](std::size_t done, std::size_t total) {
     throw_if_interrupted();  // unwinds through the staged file: nothing half-written stays
-    if (done % 64 == 0 || done == total) progress.update(static_cast<int>(done), static_cast<int>(total), "messages");
+    if (done % 64 == 0 || done == total) progress.update(static_cast<int>(done), static_cast<int>(total), "samples");
   };
   const auto start = std::chrono::steady_clock::now();
   const datasets::BagExportSummary summary = datasets::write_bag(ds, staged.path(), options);

@@ -51,7 +51,8 @@ def main():
                 entry.setdefault("messages", []).append(plain(msg))
         for topic, conns in ((c.topic, c) for c in bag._connections.values()):
             if topic in topics:
-                topics[topic]["latching"] = conns.header.get("latching", "0")
+                latching = conns.header.get("latching", b"0")
+                topics[topic]["latching"] = latching.decode() if isinstance(latching, bytes) else latching
     json.dump({"topics": topics}, sys.stdout)
 
 

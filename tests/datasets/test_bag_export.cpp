@@ -68,7 +68,7 @@ void write_small_dataset(const fs::path& dir, int frames = 3) {
   for (int k = 0; k < frames; ++k) {
     const std::int64_t t = step_ns(k, 10);
     w.ground_truth("lead", {t, {0.5 * k, 0, 10}, {0, 0, 0, 1}, {5, 0, 0}});
-    w.ground_truth("uav1", {t, {-1, 2, 15 + k}, xyzw(yaw1), {1, 0, 0}});
+    w.ground_truth("uav1", {t, {-1, 2, 15.0 + k}, xyzw(yaw1), {1, 0, 0}});
     w.ground_truth("uav2", {t, {1, -2, 17}, {0, 0, 0, 1}, {0, 0, 0}});
     for (const char* uav : {"uav1", "uav2"}) {
       cv::Mat depth(kH, kW, CV_32F, cv::Scalar(12.345f + k));
