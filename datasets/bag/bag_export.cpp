@@ -114,15 +114,11 @@ sensor_msgs::Image image_message(const cv::Mat& img, const std::string& encoding
 }
 
 // Depth as REP 118's 16UC1: millimetres, 0 = no reading, which depth_image_proc reads as it reads
-// an OpenNI camera's; the dataset's own depth is whole millimetres, so nothing is lost.
+// an OpenNI camera's. The dataset's depth is whole millimetres up to 65.535 m with 0 for none
+// (Dataset::load_depth), so the conversion rounds back exactly and 0 stays 0.
 cv::Mat depth_millimetres(const cv::Mat& metres) {
-  cv::Mat mm(metres.size(), CV_16UC1);
-  for (int r = 0; r < metres.rows; ++r)
-    for (int c = 0; c < metres.cols; ++c) {
-      const float z = metres.at<float>(r, c);
-      const double v = std::isfinite(z) && z > 0 ? std::round(z * 1000.0) : 0.0;
-      mm.at<std::uint16_t>(r, c) = static_cast<std::uint16_t>(v > 65535 ? 0 : v);
-    }
+  cv::Mat mm;
+  metres.convertTo(mm, CV_16UC1, 1000.0);
   return mm;
 }
 
