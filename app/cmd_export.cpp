@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fcntl.h>
+#include <signal.h>
 #include <fmt/core.h>
 #include <unistd.h>
 
@@ -47,6 +48,7 @@ class StagedFile {
     if (!fs::is_directory(dir, ec))
       throw UsageError(fmt::format("cannot write '{}': '{}' {}", target_.string(), dir.string(),
                                    fs::exists(dir, ec) ? "is not a directory" : "does not exist"));
+    remove_stale(dir);
     tmp_ = target_.string() + ".partial-" + std::to_string(::getpid());
     const int fd = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd < 0) throw UsageError(fmt::format("cannot write '{}': {}", target_.string(), std::strerror(errno)));
@@ -67,6 +69,21 @@ class StagedFile {
   }
 
  private:
+  // "<name>.partial-<pid>" files a killed export (SIGKILL) left beside the target: removed when
+  // their process is gone, as the staging directories of eval::ResultsDir are.
+  void remove_stale(const fs::path& dir) const {
+    const std::string prefix = target_.filename().string() + ".partial-";
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind(prefix, 0) != 0) continue;
+      const std::string pid = name.substr(prefix.size());
+      if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+      if (::kill(static_cast<pid_t>(std::stol(pid)), 0) == 0 || errno != ESRCH) continue;
+      if (fs::remove(e.path(), ec)) fmt::print(stderr, "removed {}, left by a killed export\n", e.path().string());
+    }
+  }
+
   fs::path target_, tmp_;
   bool committed_ = false;
 };

@@ -3,6 +3,7 @@
 // (tests/datasets/read_bag.py), and the bag's topics, stamps and values are checked against what
 // was written; the command's refusals exit 2 and leave nothing behind.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -106,14 +107,34 @@ void expect_quaternion(const json& q, const Eigen::Quaterniond& want) {
   EXPECT_NEAR(std::abs(got.dot(want)), 1.0, 1e-9) << q;  // q and -q are the same rotation
 }
 
-TEST(BagExport, WritesEveryTopicWithStampsImagesCameraInfoAndTransformsThatRosbagReadsBack) {
-  TempDir tmp;
-  write_small_dataset(tmp / "ds");
-  const fs::path bag = tmp / "out.bag";
-  const auto r = run_wingman({"export", (tmp / "ds").string(), "--bag", bag.string(), "-q"}, tmp.path());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const json b = read_bag(bag, tmp.path())["topics"];
+// The small dataset exported once by `wingman export` and read back by python3-rosbag.
+class BagOfSmallDataset : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    tmp_ = new TempDir;
+    write_small_dataset(*tmp_ / "ds");
+    const fs::path bag = *tmp_ / "out.bag";
+    const auto r = run_wingman({"export", (*tmp_ / "ds").string(), "--bag", bag.string(), "-q"}, tmp_->path());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    topics_ = new json(read_bag(bag, tmp_->path())["topics"]);
+  }
+  static void TearDownTestSuite() {
+    delete topics_;
+    delete tmp_;
+  }
+  static bool has_topic(const std::string& name) {
+    if (topics_ == nullptr) throw std::runtime_error("the export failed (the suite's set-up says why)");
+    return topics_->contains(name);
+  }
+  static const json& topic(const std::string& name) {
+    if (!has_topic(name)) throw std::runtime_error("no topic " + name);
+    return (*topics_)[name];
+  }
+  static inline TempDir* tmp_ = nullptr;
+  static inline json* topics_ = nullptr;
+};
 
+TEST_F(BagOfSmallDataset, EveryTopicHasItsTypeAndOneMessagePerSample) {
   const std::map<std::string, std::pair<std::string, int>> expected = {
       {"/tf", {"tf2_msgs/TFMessage", 9}},
       {"/tf_static", {"tf2_msgs/TFMessage", 1}},
@@ -130,98 +151,135 @@ TEST(BagExport, WritesEveryTopicWithStampsImagesCameraInfoAndTransformsThatRosba
       {"/uav1/range", {"sensor_msgs/Range", 3}},
       {"/uav1/ahrs", {"sensor_msgs/Imu", 3}},
   };
-  for (const auto& [topic, want] : expected) {
-    ASSERT_TRUE(b.contains(topic)) << topic;
-    EXPECT_EQ(b[topic]["type"], want.first) << topic;
-    EXPECT_EQ(b[topic]["count"], want.second) << topic;
+  for (const auto& [name, want] : expected) {
+    EXPECT_EQ(topic(name)["type"], want.first) << name;
+    EXPECT_EQ(topic(name)["count"], want.second) << name;
   }
-  EXPECT_FALSE(b.contains("/uav2/range"));  // uav2 has no range samples
-  EXPECT_EQ(b["/uav1/cam0/image_raw"]["stamps"].get<std::vector<std::int64_t>>(), steps(3));
-  EXPECT_EQ(b["/uav1/altimeter"]["stamps"].get<std::vector<std::int64_t>>(), steps(3));
-  // Record times follow the stamps; rosbag's earliest record time stands in for 0.
-  EXPECT_EQ(b["/lead/gps"]["record_ns"].get<std::vector<std::int64_t>>(), (std::vector<std::int64_t>{1, 100000000, 200000000}));
+  EXPECT_FALSE(has_topic("/uav2/range"));  // uav2 has no range samples
+  EXPECT_FALSE(has_topic("/lead/cam0/image_raw"));
+}
 
-  const json& img = b["/uav1/cam0/image_raw"]["last"];
+TEST_F(BagOfSmallDataset, StampsAreTheSamplesTimesAndRecordTimesFollowThem) {
+  EXPECT_EQ(topic("/uav1/cam0/image_raw")["stamps"].get<std::vector<std::int64_t>>(), steps(3));
+  EXPECT_EQ(topic("/uav1/altimeter")["stamps"].get<std::vector<std::int64_t>>(), steps(3));
+  // rosbag's earliest record time, 1 ns, stands in for 0.
+  EXPECT_EQ(topic("/lead/gps")["record_ns"].get<std::vector<std::int64_t>>(),
+            (std::vector<std::int64_t>{1, 100000000, 200000000}));
+}
+
+TEST_F(BagOfSmallDataset, ImagesAreRgb8OrMono8WithTheDatasetsPixels) {
+  const json& img = topic("/uav1/cam0/image_raw")["last"];
   EXPECT_EQ(img["encoding"], "rgb8");
   EXPECT_EQ(img["width"], kW);
   EXPECT_EQ(img["height"], kH);
   EXPECT_EQ(img["step"], 3 * kW);
   EXPECT_EQ(img["header"]["frame_id"], "uav1/cam0_optical");
   EXPECT_EQ(img["data"]["len"], 3 * kW * kH);
-  // Pixels (0,0) and (0,1) of frame 2: R = 0, G = 7 col, B = 102.
+  // Pixels (0,0) and (0,1) of frame 2: R = 5 row = 0, G = 7 col, B = 102.
   EXPECT_EQ(img["data"]["head"].get<std::vector<int>>().at(2), 102);
   EXPECT_EQ(img["data"]["head"].get<std::vector<int>>().at(4), 7);
 
-  const json& grey = b["/uav2/cam0/image_raw"]["first"];
+  const json& grey = topic("/uav2/cam0/image_raw")["first"];
   EXPECT_EQ(grey["encoding"], "mono8");
   EXPECT_EQ(grey["step"], kW);
   EXPECT_EQ(grey["data"]["len"], kW * kH);
+  const cv::Mat want = read_dataset(*tmp_ / "ds").load_image("uav2", 0);
+  ASSERT_EQ(want.channels(), 1);
+  for (int c = 0; c < 16; ++c) EXPECT_EQ(grey["data"]["head"][c], want.at<std::uint8_t>(0, c)) << c;
+}
 
-  const json& depth = b["/uav1/depth0/image_raw"]["first"];
+TEST_F(BagOfSmallDataset, DepthIs16UC1MillimetresWithZeroForNoSurface) {
+  const json& depth = topic("/uav1/depth0/image_raw")["first"];
   EXPECT_EQ(depth["encoding"], "16UC1");
   EXPECT_EQ(depth["step"], 2 * kW);
   // 12.345 m = 12345 mm = 0x3039, little-endian; pixel (0,1) has no surface: 0.
-  EXPECT_EQ(depth["data"]["head"].get<std::vector<int>>(), (std::vector<int>{0x39, 0x30, 0, 0, 0x39, 0x30, 0x39, 0x30,
-                                                                          0x39, 0x30, 0x39, 0x30, 0x39, 0x30, 0x39, 0x30}));
+  EXPECT_EQ(depth["data"]["head"].get<std::vector<int>>(),
+            (std::vector<int>{0x39, 0x30, 0, 0, 0x39, 0x30, 0x39, 0x30, 0x39, 0x30, 0x39, 0x30, 0x39, 0x30, 0x39, 0x30}));
+  EXPECT_EQ(topic("/uav1/depth0/camera_info")["first"]["header"]["frame_id"], "uav1/cam0_optical");
+}
 
-  const json& info = b["/uav1/cam0/camera_info"]["first"];
+TEST_F(BagOfSmallDataset, CameraInfoIsPlumbBobWithTheIntrinsics) {
+  const json& info = topic("/uav1/cam0/camera_info")["first"];
   EXPECT_EQ(info["distortion_model"], "plumb_bob");
   EXPECT_EQ(info["K"].get<std::vector<double>>(), (std::vector<double>{30.5, 0, 15.5, 0, 31.5, 11.5, 0, 0, 1}));
   EXPECT_EQ(info["D"].get<std::vector<double>>(), (std::vector<double>{0.01, -0.02, 0.001, 0.002, 0.003}));
+  EXPECT_EQ(info["R"].get<std::vector<double>>(), (std::vector<double>{1, 0, 0, 0, 1, 0, 0, 0, 1}));
   EXPECT_EQ(info["P"].get<std::vector<double>>(), (std::vector<double>{30.5, 0, 15.5, 0, 0, 31.5, 11.5, 0, 0, 0, 1, 0}));
   EXPECT_EQ(info["width"], kW);
+  EXPECT_EQ(info["height"], kH);
+}
 
-  // /tf: world -> uav1/base_link at t = 0.2 s.
+TEST_F(BagOfSmallDataset, TfCarriesEveryAgentsGroundTruthPoseFromTheWorld) {
   const Eigen::Quaterniond yaw1(Eigen::AngleAxisd(kYaw1, Eigen::Vector3d::UnitZ()));
-  int uav1_transforms = 0;
-  for (const json& m : b["/tf"]["messages"]) {
+  std::map<std::string, int> per_child;
+  for (const json& m : topic("/tf")["messages"]) {
     const json& tf = m["transforms"][0];
     EXPECT_EQ(tf["header"]["frame_id"], "world");
-    if (tf["child_frame_id"] != "uav1/base_link") continue;
-    ++uav1_transforms;
-    if (tf["header"]["stamp"] != 200000000) continue;
+    ++per_child[tf["child_frame_id"].get<std::string>()];
+    if (tf["child_frame_id"] != "uav1/base_link" || tf["header"]["stamp"] != 200000000) continue;
     EXPECT_DOUBLE_EQ(tf["transform"]["translation"]["x"].get<double>(), -1.0);
     EXPECT_DOUBLE_EQ(tf["transform"]["translation"]["z"].get<double>(), 17.0);
     expect_quaternion(tf["transform"]["rotation"], yaw1);
   }
-  EXPECT_EQ(uav1_transforms, 3);
+  EXPECT_EQ(per_child, (std::map<std::string, int>{{"lead/base_link", 3}, {"uav1/base_link", 3}, {"uav2/base_link", 3}}));
+}
 
-  // /tf_static: uav1's mount, the world offset and R_CW^T expressed in the yawed body frame.
-  const json& st = b["/tf_static"]["first"]["transforms"][0];
-  EXPECT_EQ(b["/tf_static"]["latching"], "1");
+// uav1's mount: the world-frame offset and R_CW^T expressed in its body frame, yawed by 90°.
+TEST_F(BagOfSmallDataset, TfStaticCarriesTheNominalMountInTheBodyFrameLatched) {
+  EXPECT_EQ(topic("/tf_static")["latching"], "1");
+  const json& st = topic("/tf_static")["first"]["transforms"][0];
+  EXPECT_EQ(topic("/tf_static")["first"]["transforms"].size(), 2u);
   EXPECT_EQ(st["header"]["frame_id"], "uav1/base_link");
   EXPECT_EQ(st["child_frame_id"], "uav1/cam0_optical");
   EXPECT_NEAR(st["transform"]["translation"]["x"].get<double>(), 2.0, 1e-12);
   EXPECT_NEAR(st["transform"]["translation"]["y"].get<double>(), -1.0, 1e-12);
   EXPECT_NEAR(st["transform"]["translation"]["z"].get<double>(), -0.5, 1e-12);
+  const Eigen::Quaterniond yaw1(Eigen::AngleAxisd(kYaw1, Eigen::Vector3d::UnitZ()));
   const Eigen::Matrix3d R_BC = yaw1.toRotationMatrix().transpose() * camera(1).R_CW.transpose();
   expect_quaternion(st["transform"]["rotation"], Eigen::Quaterniond(R_BC));
+}
 
-  // Odometry: uav1 moves along world +x, which is its body's -y after a 90° yaw.
-  const json& odo = b["/uav1/groundtruth/odometry"]["first"];
+// uav1 moves along world +x, which is its body's -y after a 90° yaw.
+TEST_F(BagOfSmallDataset, OdometryVelocityIsInTheBodyFrame) {
+  const json& odo = topic("/uav1/groundtruth/odometry")["first"];
+  EXPECT_EQ(odo["header"]["frame_id"], "world");
   EXPECT_EQ(odo["child_frame_id"], "uav1/base_link");
   EXPECT_NEAR(odo["twist"]["twist"]["linear"]["x"].get<double>(), 0.0, 1e-12);
   EXPECT_NEAR(odo["twist"]["twist"]["linear"]["y"].get<double>(), -1.0, 1e-12);
+  EXPECT_EQ(odo["twist"]["covariance"][21], -1);  // angular rate not recorded
   EXPECT_DOUBLE_EQ(odo["pose"]["pose"]["position"]["y"].get<double>(), 2.0);
+  EXPECT_DOUBLE_EQ(topic("/lead/groundtruth/odometry")["last"]["twist"]["twist"]["linear"]["x"].get<double>(), 5.0);
+}
 
-  // The true camera pose: the camera's orientation in the world, R_WC = R_CW^T.
-  const json& cam = b["/uav1/cam0/pose"]["last"];
+// The true camera pose: the optical frame's orientation in the world, R_WC = R_CW^T.
+TEST_F(BagOfSmallDataset, CameraPoseIsTheTrueOpticalFrameInTheWorld) {
+  const json& cam = topic("/uav1/cam0/pose")["last"];
+  EXPECT_EQ(cam["header"]["frame_id"], "world");
   EXPECT_DOUBLE_EQ(cam["pose"]["position"]["z"].get<double>(), 16.5);
   expect_quaternion(cam["pose"]["orientation"], Eigen::Quaterniond(Eigen::Matrix3d(camera(1).R_CW.transpose())));
+}
 
-  EXPECT_DOUBLE_EQ(b["/lead/gps"]["last"]["point"]["x"].get<double>(), 1.01);
-  EXPECT_FLOAT_EQ(b["/uav1/range"]["last"]["range"].get<float>(), 22.5f);
-  EXPECT_FLOAT_EQ(b["/uav1/altimeter"]["first"]["range"].get<float>(), 15.25f);
-  expect_quaternion(b["/uav1/ahrs"]["first"]["orientation"], Eigen::Quaterniond(Eigen::AngleAxisd(0.25, Eigen::Vector3d::UnitZ())));
-  EXPECT_EQ(b["/uav1/ahrs"]["first"]["angular_velocity_covariance"][0], -1);
+TEST_F(BagOfSmallDataset, GpsAltimeterRangeAndAhrsKeepTheirValues) {
+  EXPECT_DOUBLE_EQ(topic("/lead/gps")["last"]["point"]["x"].get<double>(), 1.01);
+  EXPECT_DOUBLE_EQ(topic("/lead/gps")["last"]["point"]["z"].get<double>(), 10.03);
+  EXPECT_FLOAT_EQ(topic("/uav1/range")["last"]["range"].get<float>(), 22.5f);
+  EXPECT_FLOAT_EQ(topic("/uav1/altimeter")["first"]["range"].get<float>(), 15.25f);
+  EXPECT_EQ(topic("/uav1/altimeter")["first"]["max_range"], "inf");
+  const json& ahrs = topic("/uav1/ahrs")["first"];
+  expect_quaternion(ahrs["orientation"], Eigen::Quaterniond(Eigen::AngleAxisd(0.25, Eigen::Vector3d::UnitZ())));
+  EXPECT_EQ(ahrs["angular_velocity_covariance"][0], -1);
+  EXPECT_EQ(ahrs["linear_acceleration_covariance"][0], -1);
+}
 
-  // IMU: as many messages as the dataset on disk holds samples (none where the format carries no IMU).
-  const Dataset ds = read_dataset(tmp / "ds");
-  const std::size_t n_imu = ds.agent("uav1").imu.size();
-  EXPECT_EQ(b.contains("/uav1/imu0") ? b["/uav1/imu0"]["count"].get<std::size_t>() : 0u, n_imu);
+// As many IMU messages as the dataset on disk holds samples (none where its format carries no IMU).
+TEST_F(BagOfSmallDataset, ImuTopicHoldsTheDatasetsImuSamples) {
+  const std::size_t n_imu = read_dataset(*tmp_ / "ds").agent("uav1").imu.size();
+  const std::size_t in_bag = has_topic("/uav1/imu0") ? topic("/uav1/imu0")["count"].get<std::size_t>() : 0u;
+  EXPECT_EQ(in_bag, n_imu);
   if (n_imu > 0) {
-    EXPECT_EQ(b["/uav1/imu0"]["count"], 60);
-    EXPECT_DOUBLE_EQ(b["/uav1/imu0"]["last"]["angular_velocity"]["z"].get<double>(), 19.3);
+    EXPECT_EQ(in_bag, 60u);
+    EXPECT_DOUBLE_EQ(topic("/uav1/imu0")["last"]["angular_velocity"]["z"].get<double>(), 19.3);
+    EXPECT_EQ(topic("/uav1/imu0")["last"]["header"]["stamp"], 200000000 + 19 * 5000000);
   }
 }
 
@@ -274,6 +332,22 @@ TEST(BagExport, RefusesToReplaceAnExistingFileWithoutForce) {
   EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator{}), 2);  // ds and the bag
 }
 
+// A SIGKILLed export's partial file (its pid gone) goes with the next export to the same file;
+// a running export's stays.
+TEST(BagExport, PartialFileOfAKilledExportIsRemovedByTheNext) {
+  TempDir tmp;
+  write_small_dataset(tmp / "ds");
+  write_file(tmp / "out.bag.partial-999999999", "killed");  // above any pid_max
+  const std::string running = "out.bag.partial-" + std::to_string(::getpid());
+  write_file(tmp / running, "running");
+  const auto r = run_wingman({"export", (tmp / "ds").string(), "--bag", (tmp / "out.bag").string(), "-q"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(tmp / "out.bag.partial-999999999"));
+  EXPECT_NE(r.output.find("out.bag.partial-999999999"), std::string::npos) << r.output;
+  EXPECT_EQ(read_file(tmp / running), "running");
+  EXPECT_TRUE(fs::exists(tmp / "out.bag"));
+}
+
 TEST(BagExport, UnwritablePathExitsTwoNamingItAndLeavesNothing) {
   TempDir tmp;
   write_small_dataset(tmp / "ds");
@@ -301,6 +375,9 @@ TEST(BagExport, InterruptedExportLeavesNoFile) {
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, STDOUT_FILENO);
+    ::dup2(null, STDERR_FILENO);
     ::execl(app::test::kBinary.c_str(), "wingman", "export", (tmp / "ds").c_str(), "--bag", bag.c_str(), "-q",
             static_cast<char*>(nullptr));
     ::_exit(127);
