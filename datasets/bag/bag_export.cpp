@@ -202,22 +202,19 @@ BagExportSummary Writer::run() {
   return summary_;
 }
 
-// The nominal mounts: each camera's commanded attitude and offset, both world-frame quantities,
-// expressed in its body frame at the body's first ground-truth attitude. A gimbal holds the
-// camera's world attitude, so this is exact while the body keeps that attitude; the true camera
-// pose is /<uav>/cam0/pose.
+// The nominal mounts, the dataset's T_BS of cam0 (docs/datasets.md, frames): the commanded
+// attitude at body yaw 0, R_BC = R_CW^T, and the offset d. The gimbal holds the camera's world
+// attitude, so this is the commanded camera pose while the body's yaw is 0 (open-loop UAVs), and
+// never includes the gimbal error; the true camera pose is /<uav>/cam0/pose.
 void Writer::write_static_mounts(std::int64_t t_ns) {
   tf2_msgs::TFMessage tf;
   for (const AgentData& a : ds_.agents) {
     if (!a.camera) continue;
-    const Eigen::Matrix3d R_WB =
-        a.groundtruth.empty() ? Eigen::Matrix3d::Identity() : body_rotation(a.groundtruth.front()).toRotationMatrix();
-    const Eigen::Matrix3d R_BC = R_WB.transpose() * a.camera->R_CW.transpose();
     geometry_msgs::TransformStamped m;
     m.header = header(t_ns, bag_body_frame(a.name));
     m.child_frame_id = bag_camera_frame(a.name);
-    set_xyz(m.transform.translation, R_WB.transpose() * a.camera->offset);
-    m.transform.rotation = quaternion(Eigen::Quaterniond(R_BC).normalized());
+    set_xyz(m.transform.translation, a.camera->offset);
+    m.transform.rotation = quaternion(Eigen::Quaterniond(a.camera->R_CW.transpose()).normalized());
     tf.transforms.push_back(m);
   }
   if (tf.transforms.empty()) return;

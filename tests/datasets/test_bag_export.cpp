@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 const fs::path kReadBag = app::test::kSourceDir / "tests" / "datasets" / "read_bag.py";
 constexpr int kW = 32, kH = 24;
 const Eigen::Vector3d kOffset(1.0, 2.0, -0.5);
-const double kYaw1 = M_PI / 2;  // uav1's body yaw: the mount and the body-frame velocity depend on it
+const double kYaw1 = M_PI / 2;  // uav1's body yaw: its body-frame velocity depends on it
 
 Eigen::Vector4d xyzw(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(), q.w()}; }
 
@@ -45,16 +45,23 @@ cv::Mat pattern(int k) {
   return img;
 }
 
+// A nadir camera turned by 0.3 rad about its axis: R_CW is not symmetric, so R_CW and R_CW^T differ.
+Eigen::Matrix3d R_CW() {
+  return Eigen::Matrix3d(Eigen::Vector3d(1, -1, -1).asDiagonal()) *
+         Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
 CameraInfo camera(int channels) {
   CameraInfo c;
   c.camera = geometry::PinholeCamera(30.5, 31.5, 15.5, 11.5, kW, kH, {0.01, -0.02, 0.001, 0.002, 0.003});
-  c.R_CW = Eigen::Vector3d(1, -1, -1).asDiagonal();  // nadir
+  c.R_CW = R_CW();
   c.offset = kOffset;
   c.channels = channels;
   return c;
 }
 
-// lead (no camera, GPS), uav1 (colour, yawed 90°, altimeter, range, AHRS), uav2 (grey); 3 frames at 10 Hz.
+// lead (no camera, GPS), uav1 (colour, yawed 90°, altimeter, range, AHRS), uav2 (grey); frames at
+// 10 Hz, each UAV's IMU at 200 Hz.
 void write_small_dataset(const fs::path& dir, int frames = 3) {
   fs::create_directories(dir);
   DatasetInfo info;
@@ -64,7 +71,10 @@ void write_small_dataset(const fs::path& dir, int frames = 3) {
   w.add_agent("lead", std::nullopt);
   w.add_agent("uav1", camera(3));
   w.add_agent("uav2", camera(1));
-  w.imu_info("uav1", ImuInfo{200, 0.01, 0.001, 0.1, 0.01});
+  for (const char* uav : {"uav1", "uav2"}) {
+    w.imu_info(uav, ImuInfo{200, 0.01, 0.001, 0.1, 0.01});
+    for (int i = 0; i <= 20 * (frames - 1); ++i) w.imu(uav, {step_ns(i, 200), {0.1, -0.2, 0.3 + i}, {0.5, 0.25, 9.81}});
+  }
   const Eigen::Quaterniond yaw1(Eigen::AngleAxisd(kYaw1, Eigen::Vector3d::UnitZ()));
   for (int k = 0; k < frames; ++k) {
     const std::int64_t t = step_ns(k, 10);
@@ -75,14 +85,12 @@ void write_small_dataset(const fs::path& dir, int frames = 3) {
       cv::Mat depth(kH, kW, CV_32F, cv::Scalar(12.345f + k));
       depth.at<float>(0, 1) = 0;  // no surface
       w.write_frame(uav, t, pattern(k), depth);
-      const Eigen::Matrix3d R_CW = camera(1).R_CW;
-      w.camera_pose(uav, {t, Eigen::Vector3d(0.1, 0.2, 14.5 + k), xyzw(Eigen::Quaterniond(R_CW))});
+      w.camera_pose(uav, {t, Eigen::Vector3d(0.1, 0.2, 14.5 + k), xyzw(Eigen::Quaterniond(R_CW()))});
     }
     w.gps("lead", {t, {0.5 * k + 0.01, -0.02, 10.03}});
     w.altimeter("uav1", {t, 15.25 + k});
     w.range("uav1", {t, 20.5 + k});
     w.ahrs("uav1", {t, 0.25});
-    for (int i = 0; i < 20; ++i) w.imu("uav1", {t + i * 5'000'000, {0.1, -0.2, 0.3 + i}, {0.5, 0.25, 9.81}});
   }
   w.finish();
 }
@@ -150,6 +158,7 @@ TEST_F(BagOfSmallDataset, EveryTopicHasItsTypeAndOneMessagePerSample) {
       {"/uav1/altimeter", {"sensor_msgs/Range", 3}},
       {"/uav1/range", {"sensor_msgs/Range", 3}},
       {"/uav1/ahrs", {"sensor_msgs/Imu", 3}},
+      {"/uav1/imu0", {"sensor_msgs/Imu", 41}},
   };
   for (const auto& [name, want] : expected) {
     EXPECT_EQ(topic(name)["type"], want.first) << name;
@@ -224,19 +233,18 @@ TEST_F(BagOfSmallDataset, TfCarriesEveryAgentsGroundTruthPoseFromTheWorld) {
   EXPECT_EQ(per_child, (std::map<std::string, int>{{"lead/base_link", 3}, {"uav1/base_link", 3}, {"uav2/base_link", 3}}));
 }
 
-// uav1's mount: the world-frame offset and R_CW^T expressed in its body frame, yawed by 90°.
-TEST_F(BagOfSmallDataset, TfStaticCarriesTheNominalMountInTheBodyFrameLatched) {
+// uav1's mount: the dataset's nominal T_BS of cam0, the offset and R_CW^T, whatever the body's
+// attitude (uav1 is yawed by 90°).
+TEST_F(BagOfSmallDataset, TfStaticCarriesTheNominalMountLatched) {
   EXPECT_EQ(topic("/tf_static")["latching"], "1");
   const json& st = topic("/tf_static")["first"]["transforms"][0];
   EXPECT_EQ(topic("/tf_static")["first"]["transforms"].size(), 2u);
   EXPECT_EQ(st["header"]["frame_id"], "uav1/base_link");
   EXPECT_EQ(st["child_frame_id"], "uav1/cam0_optical");
-  EXPECT_NEAR(st["transform"]["translation"]["x"].get<double>(), 2.0, 1e-12);
-  EXPECT_NEAR(st["transform"]["translation"]["y"].get<double>(), -1.0, 1e-12);
+  EXPECT_NEAR(st["transform"]["translation"]["x"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(st["transform"]["translation"]["y"].get<double>(), 2.0, 1e-12);
   EXPECT_NEAR(st["transform"]["translation"]["z"].get<double>(), -0.5, 1e-12);
-  const Eigen::Quaterniond yaw1(Eigen::AngleAxisd(kYaw1, Eigen::Vector3d::UnitZ()));
-  const Eigen::Matrix3d R_BC = yaw1.toRotationMatrix().transpose() * camera(1).R_CW.transpose();
-  expect_quaternion(st["transform"]["rotation"], Eigen::Quaterniond(R_BC));
+  expect_quaternion(st["transform"]["rotation"], Eigen::Quaterniond(Eigen::Matrix3d(R_CW().transpose())));
 }
 
 // uav1 moves along world +x, which is its body's -y after a 90° yaw.
@@ -256,7 +264,7 @@ TEST_F(BagOfSmallDataset, CameraPoseIsTheTrueOpticalFrameInTheWorld) {
   const json& cam = topic("/uav1/cam0/pose")["last"];
   EXPECT_EQ(cam["header"]["frame_id"], "world");
   EXPECT_DOUBLE_EQ(cam["pose"]["position"]["z"].get<double>(), 16.5);
-  expect_quaternion(cam["pose"]["orientation"], Eigen::Quaterniond(Eigen::Matrix3d(camera(1).R_CW.transpose())));
+  expect_quaternion(cam["pose"]["orientation"], Eigen::Quaterniond(Eigen::Matrix3d(R_CW().transpose())));
 }
 
 TEST_F(BagOfSmallDataset, GpsAltimeterRangeAndAhrsKeepTheirValues) {
@@ -271,16 +279,19 @@ TEST_F(BagOfSmallDataset, GpsAltimeterRangeAndAhrsKeepTheirValues) {
   EXPECT_EQ(ahrs["linear_acceleration_covariance"][0], -1);
 }
 
-// As many IMU messages as the dataset on disk holds samples (none where its format carries no IMU).
+// Every IMU sample of the dataset, 200 Hz from 0 to the last frame, with the values written.
 TEST_F(BagOfSmallDataset, ImuTopicHoldsTheDatasetsImuSamples) {
-  const std::size_t n_imu = read_dataset(*tmp_ / "ds").agent("uav1").imu.size();
-  const std::size_t in_bag = has_topic("/uav1/imu0") ? topic("/uav1/imu0")["count"].get<std::size_t>() : 0u;
-  EXPECT_EQ(in_bag, n_imu);
-  if (n_imu > 0) {
-    EXPECT_EQ(in_bag, 60u);
-    EXPECT_DOUBLE_EQ(topic("/uav1/imu0")["last"]["angular_velocity"]["z"].get<double>(), 19.3);
-    EXPECT_EQ(topic("/uav1/imu0")["last"]["header"]["stamp"], 200000000 + 19 * 5000000);
-  }
+  EXPECT_EQ(read_dataset(*tmp_ / "ds").agent("uav1").imu.size(), 41u);
+  const json& imu = topic("/uav1/imu0");
+  EXPECT_EQ(imu["type"], "sensor_msgs/Imu");
+  EXPECT_EQ(imu["count"], 41);
+  EXPECT_EQ(imu["stamps"][1], 5000000);
+  EXPECT_EQ(imu["last"]["header"]["stamp"], 200000000);
+  EXPECT_EQ(imu["last"]["header"]["frame_id"], "uav1/base_link");
+  EXPECT_DOUBLE_EQ(imu["last"]["angular_velocity"]["z"].get<double>(), 40.3);
+  EXPECT_DOUBLE_EQ(imu["last"]["linear_acceleration"]["z"].get<double>(), 9.81);
+  EXPECT_NEAR(imu["last"]["angular_velocity_covariance"][4].get<double>(), 0.01 * 0.01 * 200, 1e-15);
+  EXPECT_EQ(topic("/uav2/imu0")["count"], 41);
 }
 
 // The IMU through the library on an in-memory dataset (no frames needed): the samples' values in
@@ -384,16 +395,20 @@ TEST(BagExport, InterruptedExportLeavesNoFile) {
   }
   // Wait until the export has begun writing, then interrupt it.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  const std::string tmp_name = "out.bag.partial-" + std::to_string(pid);
-  while (!(fs::exists(tmp / tmp_name) && fs::file_size(tmp / tmp_name) > 0) && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  ::kill(pid, SIGINT);
+  const fs::path partial = tmp / ("out.bag.partial-" + std::to_string(pid));
   int status = 0;
+  std::error_code ec;
+  while (fs::file_size(partial, ec) == 0 || ec) {
+    if (::waitpid(pid, &status, WNOHANG) == pid) FAIL() << "the export ended before it was interrupted: " << status;
+    if (std::chrono::steady_clock::now() > deadline) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ::kill(pid, SIGINT);
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 130);
   EXPECT_FALSE(fs::exists(bag));
-  EXPECT_FALSE(fs::exists(tmp / tmp_name));
+  EXPECT_FALSE(fs::exists(partial));
 }
 
 }  // namespace
