@@ -326,6 +326,27 @@ TEST(BagExport, ImuMessagesCarryTheSamplesAndCovariancesFromTheNoiseDensities) {
   EXPECT_NEAR(last["linear_acceleration_covariance"][4].get<double>(), 0.1 * 0.1 * 200, 1e-15);
 }
 
+// A dataset of format version 1 (no IMU; tests/datasets/to_format_version_1.py) exports the same
+// topics less the IMU's, with the same mount.
+TEST(BagExport, FormatVersion1DatasetExportsWithoutImuTopics) {
+  TempDir tmp;
+  write_small_dataset(tmp / "ds");
+  const fs::path convert = app::test::kSourceDir / "tests" / "datasets" / "to_format_version_1.py";
+  const std::string cmd = "/usr/bin/python3 " + app::test::quote(convert.string()) + " " + app::test::quote((tmp / "ds").string());
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  ASSERT_EQ(read_dataset(tmp / "ds").info.format_version, 1);
+  const auto r = run_wingman({"export", (tmp / "ds").string(), "--bag", (tmp / "v1.bag").string(), "-q"}, tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json b = read_bag(tmp / "v1.bag", tmp.path())["topics"];
+  EXPECT_FALSE(b.contains("/uav1/imu0"));
+  EXPECT_FALSE(b.contains("/uav2/imu0"));
+  EXPECT_EQ(b["/uav1/cam0/image_raw"]["count"], 3);
+  EXPECT_EQ(b["/tf"]["count"], 9);
+  const json& st = b["/tf_static"]["first"]["transforms"][0];
+  EXPECT_NEAR(st["transform"]["translation"]["y"].get<double>(), 2.0, 1e-9);
+  expect_quaternion(st["transform"]["rotation"], Eigen::Quaterniond(Eigen::Matrix3d(R_CW().transpose())));
+}
+
 TEST(BagExport, RefusesToReplaceAnExistingFileWithoutForce) {
   TempDir tmp;
   write_small_dataset(tmp / "ds");
