@@ -19,6 +19,9 @@ packages=(
   libopencv-dev libopencv-contrib-dev libassimp-dev zlib1g-dev libpugixml-dev libxxhash-dev libzstd-dev
   libegl-dev libgl-dev libosmesa6-dev libegl-mesa0 libgl1-mesa-dri
   gnuplot-nox python3 python3-yaml
+  librosbag-storage-dev libroscpp-core-dev libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev
+  libnav-msgs-dev libtf2-msgs-dev
+  python3-rosbag python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-tf2-msgs
   slurm-wlm munge
 )
 

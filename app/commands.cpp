@@ -42,6 +42,7 @@ int run_cli(int argc, char** argv) {
       add_bench_frontend(cli),
       add_baseline(cli),
       add_check(cli),
+      add_export(cli),
   };
 
   // A first word that is neither an option nor a command: say so and list the commands.

@@ -24,7 +24,7 @@ const char* signal_name(int sig) {
 
 Interrupted::Interrupted(int sig)
     : std::runtime_error(std::string("interrupted by ") + signal_name(sig) +
-                         ": stopped, nothing written (the staging directory is removed)"),
+                         ": stopped, nothing written (the staged output is removed)"),
       signal(sig) {}
 
 InterruptGuard::InterruptGuard() {

@@ -30,6 +30,7 @@ Subcommand add_slam(CLI::App& parent);           // app/cmd_slam.cpp
 Subcommand add_bench_frontend(CLI::App& parent); // app/cmd_bench_frontend.cpp
 Subcommand add_baseline(CLI::App& parent);       // app/cmd_baseline.cpp
 Subcommand add_check(CLI::App& parent);          // app/cmd_check.cpp
+Subcommand add_export(CLI::App& parent);         // app/cmd_export.cpp
 // Further subcommands declare their add_<name>() here.
 
 }  // namespace wingman::app
