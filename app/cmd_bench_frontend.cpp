@@ -1,19 +1,30 @@
-// `wingman bench-frontend <dataset-dir>`: the whole replay (frontend and estimator) once per
-// feature detector, and one table: ms per frame of detection + description, tracked matches per
-// frame, the fraction of them correct against the ground-truth labels, cooperative pairs and
-// landmarks initialised. The estimator is in the loop because what it predicts is what tracking
-// searches for; the lead detector and everything else stay as in `wingman slam`.
+// `wingman bench-frontend <dataset-dir>`: the built-in feature detectors as a matching benchmark.
+// By default each detector runs outside the SLAM loop on the benchmark's frame pairs (detect,
+// describe, match by brute force with the ratio test and a mutual check), writes its keypoints
+// and matches in the benchmark's file format, and is scored from those files by the same reader
+// and scorer as `wingman score-matches` (docs/frontend.md). `--in-loop` instead replays the whole
+// SLAM loop once per detector (tracking decides how many matches it asks for, so there every
+// detector lands near the same count): ms per frame, tracked matches per frame and the fraction
+// correct against the ground-truth labels, cooperative pairs and landmarks initialised.
 #include "app/cli_options.hpp"
 #include "app/subcommand.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "app/match_bench.hpp"
 #include "app/pipeline.hpp"
 #include "app/progress.hpp"
 #include "app/vision_frontend.hpp"
@@ -23,6 +34,8 @@
 
 namespace wingman::app {
 
+namespace fs = std::filesystem;
+
 namespace {
 
 struct BenchOptions {
@@ -31,10 +44,14 @@ struct BenchOptions {
   StepLimit limit;
   std::vector<std::string> detectors{"orb", "gftt_orb", "akaze", "sift"};
   int max_features = 0;  // 0: the scenario's frontend.max_features
-  bool quiet = false;
+  bool in_loop = false;
+  PairCli pairs;
+  eval::ScoreOptions score;
+  vision::DescriptorMatchSettings matching;
+  MatchOutput output;
 };
 
-int bench_command(const BenchOptions& o, const std::string& variant) {
+void check_detectors(const BenchOptions& o) {
   for (const auto& name : o.detectors) {  // a typo is a usage error, before any loading
     try {
       vision::parse_detector(name);
@@ -42,10 +59,10 @@ int bench_command(const BenchOptions& o, const std::string& variant) {
       throw UsageError(e.what());
     }
   }
-  Replay replay = load_replay(o.dataset, variant, o.quiet);
-  apply_step_limit(o.limit, replay.scenario);
-  const RunConfig& scn = replay.scenario;
-  // Each detector with the rest of the scenario's frontend section (bucketing, thresholds).
+}
+
+// Each detector with the rest of the scenario's frontend section (bucketing, thresholds).
+std::vector<vision::FeatureSettings> detector_settings(const BenchOptions& o, const RunConfig& scn) {
   std::vector<vision::FeatureSettings> settings;
   for (const auto& name : o.detectors) {
     vision::FeatureSettings f = scn.frontend.features;
@@ -58,6 +75,16 @@ int bench_command(const BenchOptions& o, const std::string& variant) {
       throw UsageError(e.what());
     }
   }
+  return settings;
+}
+
+// The whole replay once per detector.
+int in_loop_command(const BenchOptions& o, const std::string& variant) {
+  if (!o.output.out.empty()) throw UsageError("--out writes the matching benchmark; it does not go with --in-loop");
+  Replay replay = load_replay(o.dataset, variant, o.output.quiet);
+  apply_step_limit(o.limit, replay.scenario);
+  const RunConfig& scn = replay.scenario;
+  const std::vector<vision::FeatureSettings> settings = detector_settings(o, scn);
 
   struct Row {
     std::string name;
@@ -67,7 +94,7 @@ int bench_command(const BenchOptions& o, const std::string& variant) {
   };
   std::vector<Row> rows;
   for (const auto& f : settings) {
-    ProgressLine progress(fmt::format("[bench-frontend {}]", vision::to_string(f.kind)), o.quiet);
+    ProgressLine progress(fmt::format("[bench-frontend {}]", vision::to_string(f.kind)), o.output.quiet);
     const eval::RunRecord rec =
         run_replay(scn, replay.dataset, [&](int k, int n) { progress.update(k, n, "steps"); }, f);
     progress.finish();
@@ -108,13 +135,93 @@ int bench_command(const BenchOptions& o, const std::string& variant) {
   return 0;
 }
 
+// A directory for the detectors' files when no --out keeps them: removed with everything in it.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string tmpl = (fs::temp_directory_path() / "wingman-bench-frontend-XXXXXX").string();
+    if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("cannot make a temporary directory in " + fs::temp_directory_path().string());
+    path_ = tmpl;
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// The pairs whose frames both lie within --duration / --frames of the dataset's first frame.
+std::vector<eval::FramePair> limit_pairs(std::vector<eval::FramePair> pairs, const StepLimit& limit,
+                                         const datasets::Dataset& ds) {
+  const auto seconds = limit.seconds(ds.info.rate);
+  if (!seconds) return pairs;
+  std::int64_t t0 = std::numeric_limits<std::int64_t>::max();
+  for (const auto& a : ds.agents)
+    if (!a.frames.empty()) t0 = std::min(t0, a.frames.front());
+  const auto t_end = t0 + static_cast<std::int64_t>(std::llround(*seconds * 1e9));
+  std::erase_if(pairs, [&](const eval::FramePair& p) { return std::max(p.t_a, p.t_b) > t_end; });
+  if (pairs.empty()) throw UsageError("no frame pairs within --duration/--frames");
+  return pairs;
+}
+
+int benchmark_command(const BenchOptions& o, const std::string& variant) {
+  try {
+    o.score.validate();
+    o.matching.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  std::optional<eval::ResultsDir> staged;
+  open_match_output(o.output, staged);
+  const Replay replay = load_replay(o.dataset, variant, o.output.quiet);
+  const datasets::Dataset& ds = replay.dataset;
+  const auto pairs = limit_pairs(load_pairs(ds, o.pairs), o.limit, ds);
+  std::optional<ScratchDir> scratch;
+  if (!staged) scratch.emplace();
+  const fs::path root = staged ? staged->staging() / "frontends" : scratch->path();
+  eval::MatchReport report = eval::make_report(o.dataset, pairs, o.score);
+  for (const auto& f : detector_settings(o, replay.scenario)) {
+    const std::string name = vision::to_string(f.kind);
+    ProgressLine progress(fmt::format("[bench-frontend {}]", name), o.output.quiet);
+    const BuiltinFrontendRun run = run_builtin_frontend(
+        ds, pairs, {f, o.matching}, root / name, [&](int k, int n) { progress.update(k, n, "pairs"); });
+    // Scored from the files just written, through the reader any other frontend goes through.
+    const auto counts = eval::score_directory(ds, pairs, root / name, o.score);
+    progress.finish();
+    eval::MethodScores m;
+    m.name = name;
+    m.detect_ms_per_frame = run.frames > 0 ? run.detect_ms / run.frames : 0.0;
+    m.detect_cpu_ms_per_frame = run.frames > 0 ? run.detect_cpu_ms / run.frames : 0.0;
+    m.keypoints_per_frame = run.frames > 0 ? static_cast<double>(run.keypoints) / run.frames : 0.0;
+    m.groups = eval::group_scores(pairs, counts, o.score);
+    report.methods.push_back(std::move(m));
+  }
+  fmt::print("Feature frontends on {}: {} pairs ({} temporal, {} cross-UAV), matched by brute force "
+             "(ratio {}, {})\n",
+             o.dataset, report.pairs, report.temporal_pairs, report.cross_pairs, o.matching.ratio,
+             o.matching.mutual ? "mutual" : "one way");
+  publish_match_report(report, o.output, staged);
+  return 0;
+}
+
+int bench_command(const BenchOptions& o, const std::string& variant) {
+  check_detectors(o);
+  return o.in_loop ? in_loop_command(o, variant) : benchmark_command(o, variant);
+}
+
 }  // namespace
 
 Subcommand add_bench_frontend(CLI::App& parent) {
   auto o = std::make_shared<BenchOptions>();
   auto* cmd = parent.add_subcommand(
-      "bench-frontend", "Replay a rendered dataset once per feature detector and compare them: ms "
-                        "per frame, matches per frame, fraction correct, landmarks initialised");
+      "bench-frontend", "Benchmark the built-in feature detectors on a rendered dataset's frame "
+                        "pairs against the true correspondences (repeatability, precision, recall, "
+                        "localisation, ms per frame); --in-loop: replay the SLAM loop per detector");
   cmd->add_option("dataset", o->dataset, "Dataset directory (from wingman render)")->required();
   add_variant_option(cmd, o->variants, "Estimator settings of this variant (default: the dataset's)");
   add_step_limit(cmd, o->limit);
@@ -123,7 +230,14 @@ Subcommand add_bench_frontend(CLI::App& parent) {
   cmd->add_option("--max-features", o->max_features,
                   "Features per frame (default: the scenario's frontend.max_features)")
       ->check(CLI::Range(10, 100000));
-  cmd->add_flag("--quiet,-q", o->quiet, "No progress lines");
+  cmd->add_flag("--in-loop", o->in_loop,
+                "Replay the whole SLAM loop per detector instead (tracked matches, landmarks)");
+  add_pair_options(cmd, o->pairs, true);
+  add_score_options(cmd, o->score);
+  cmd->add_option("--ratio", o->matching.ratio, "Lowe's ratio test of the brute-force matcher")
+      ->capture_default_str()->check(CLI::Range(0.01, 1.0));
+  cmd->add_flag("!--no-mutual", o->matching.mutual, "Keep one-way matches (no cross-check)");
+  add_match_output_options(cmd, o->output);
   return {cmd, [o] {
             return for_each_variant(o->variants, [&](const std::string& v) { return bench_command(*o, v); });
           }};

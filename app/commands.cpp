@@ -13,6 +13,7 @@
 #include "app/subcommand.hpp"
 #include "app/version.hpp"
 #include "datasets/dataset.hpp"
+#include "eval/match_files.hpp"
 #include "eval/metric_set.hpp"
 #include "sim/scenario.hpp"
 #include "sim/yaml_input.hpp"
@@ -40,6 +41,8 @@ int run_cli(int argc, char** argv) {
       add_render(cli),
       add_slam(cli),
       add_bench_frontend(cli),
+      add_pairs(cli),
+      add_score_matches(cli),
       add_baseline(cli),
       add_check(cli),
       add_export(cli),
@@ -79,6 +82,9 @@ int run_cli(int argc, char** argv) {
     report("error: ", e.what());
     return 2;
   } catch (const datasets::DatasetError& e) {  // a frame or file of a dataset that is bad input
+    report("error: ", e.what());
+    return 2;
+  } catch (const eval::MatchInputError& e) {  // a pairs, keypoints or matches file
     report("error: ", e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -28,6 +28,8 @@ Subcommand add_observability(CLI::App& parent);  // app/cmd_observability.cpp
 Subcommand add_render(CLI::App& parent);         // app/cmd_render.cpp
 Subcommand add_slam(CLI::App& parent);           // app/cmd_slam.cpp
 Subcommand add_bench_frontend(CLI::App& parent); // app/cmd_bench_frontend.cpp
+Subcommand add_pairs(CLI::App& parent);          // app/cmd_score_matches.cpp
+Subcommand add_score_matches(CLI::App& parent);  // app/cmd_score_matches.cpp
 Subcommand add_baseline(CLI::App& parent);       // app/cmd_baseline.cpp
 Subcommand add_check(CLI::App& parent);          // app/cmd_check.cpp
 Subcommand add_export(CLI::App& parent);         // app/cmd_export.cpp

@@ -431,4 +431,34 @@ fs::path plot_monte_carlo_nees(const std::vector<MonteCarloSummary>& summaries, 
   return make_plot(dir, "montecarlo_nees", body + plot + "\n", 1100, 500);
 }
 
+fs::path plot_match_curves(const std::vector<std::string>& methods, const fs::path& dir) {
+  if (methods.empty()) throw std::invalid_argument("plot_match_curves: nothing to plot");
+  if (!fs::is_regular_file(dir / "curves.csv"))
+    throw std::runtime_error("cannot draw the match curves: " + (dir / "curves.csv").string() + " does not exist");
+  fs::create_directories(dir / "plots");
+  static const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"};
+  static const char* panels[][2] = {{"precision", "matching precision"},
+                                    {"recall", "matching recall"},
+                                    {"repeatability", "repeatability"}};
+  std::string s = "set multiplot layout 1,3 title 'Feature frontends against the true correspondences "
+                  "(solid: temporal pairs, dashed: cross-UAV pairs)'\n"
+                  "set xlabel 'threshold [px]'\nset yrange [0:1]\nset key bottom right opaque box\n";
+  for (const auto& [column, title] : panels) {
+    s += fmt::format("set title {}\nset ylabel {}\nplot ", gq(title), gq(column));
+    for (std::size_t m = 0; m < methods.size(); ++m)
+      for (const char* type : {"temporal", "cross"}) {
+        s += fmt::format(
+            "{}'curves.csv' using (column('threshold_px')):((strcol('method') eq {} && "
+            "strcol('type') eq '{}' && strcol('baseline') eq 'all') ? {} : NaN) with linespoints "
+            "lw 1.5 pt 7 ps 0.6 dt {} lc rgb '{}' title {}",
+            m == 0 && type[0] == 't' ? "" : ", \\\n     ", gq(methods[m]), type, col(column),
+            type[0] == 't' ? 1 : 2, colours[m % std::size(colours)],
+            gq(methods[m] + " " + type));
+      }
+    s += "\n";
+  }
+  s += "unset multiplot\n";
+  return make_plot(dir, "match_curves", s, 1800, 600);
+}
+
 }  // namespace wingman::eval

@@ -40,4 +40,11 @@ void plot_comparison(const std::vector<std::string>& results_dirs,
 std::filesystem::path plot_monte_carlo_nees(const std::vector<MonteCarloSummary>& summaries,
                                             const std::filesystem::path& dir);
 
+// The matching benchmark's curves (docs/frontend.md, benchmark of feature frontends): precision,
+// recall and repeatability against the pixel threshold, one line per method and pair type, in
+// <dir>/plots/match_curves.png and .gp, reading <dir>/curves.csv (columns method, type,
+// baseline, threshold_px, repeatability, precision, recall).
+std::filesystem::path plot_match_curves(const std::vector<std::string>& methods,
+                                        const std::filesystem::path& dir);
+
 }  // namespace wingman::eval

@@ -241,9 +241,9 @@ TEST(RenderedPipeline, SlamAndBenchFrontendReplayARenderedDataset) {
     EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 10);
   }
 
-  // bench-frontend on the same dataset: one row per detector asked for.
-  r = run_wingman({"bench-frontend", ds.string(), "--detector", "orb", "--detector", "gftt_orb",
-                   "--quiet"},
+  // bench-frontend --in-loop on the same dataset: one row per detector asked for.
+  r = run_wingman({"bench-frontend", ds.string(), "--in-loop", "--detector", "orb", "--detector",
+                   "gftt_orb", "--quiet"},
                   dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, ::testing::ContainsRegex("\norb +[0-9.]+ +[0-9.]+ +[0-9.]+%"));
