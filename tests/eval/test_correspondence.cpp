@@ -88,7 +88,9 @@ TEST(TrueCorrespondence, RoundTripThroughDistortedYawedCamerasReturnsThePixel) {
     // The distortion is applied: the undistorted projection differs.
     const Eigen::Vector3d p_B = b.R_CW * (ab.point_W - b.centre);
     const Eigen::Vector2d pinhole(50 * p_B.x() / p_B.z() + 49.5, 50 * p_B.y() / p_B.z() + 49.5);
-    if ((pinhole - Eigen::Vector2d(49.5, 49.5)).norm() > 30) EXPECT_GT((pinhole - ab.uv_b).norm(), 0.5);
+    if ((pinhole - Eigen::Vector2d(49.5, 49.5)).norm() > 30) {
+      EXPECT_GT((pinhole - ab.uv_b).norm(), 0.5);
+    }
   }
   EXPECT_GT(found, 120);
 }
