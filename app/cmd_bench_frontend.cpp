@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "app/interrupt.hpp"
 #include "app/match_bench.hpp"
 #include "app/pipeline.hpp"
 #include "app/progress.hpp"
@@ -188,10 +189,15 @@ int benchmark_command(const BenchOptions& o, const std::string& variant) {
   for (const auto& f : detector_settings(o, replay.scenario)) {
     const std::string name = vision::to_string(f.kind);
     ProgressLine progress(fmt::format("[bench-frontend {}]", name), o.output.quiet);
-    const BuiltinFrontendRun run = run_builtin_frontend(
-        ds, pairs, {f, o.matching}, root / name, [&](int k, int n) { progress.update(k, n, "pairs"); });
+    const BuiltinFrontendRun run = run_builtin_frontend(ds, pairs, {f, o.matching}, root / name, [&](int k, int n) {
+      throw_if_interrupted();
+      progress.update(k, n, "pairs matched");
+    });
     // Scored from the files just written, through the reader any other frontend goes through.
-    const auto counts = eval::score_directory(ds, pairs, root / name, o.score);
+    const auto counts = eval::score_directory(ds, pairs, root / name, o.score, [&](int k, int n) {
+      throw_if_interrupted();
+      progress.update(k, n, "pairs scored");
+    });
     progress.finish();
     eval::MethodScores m;
     m.name = name;

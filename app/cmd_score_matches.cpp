@@ -10,6 +10,7 @@
 #include <string>
 
 #include "app/match_bench.hpp"
+#include "app/interrupt.hpp"
 #include "app/progress.hpp"
 #include "app/subcommand.hpp"
 #include "eval/atomic_file.hpp"
@@ -59,7 +60,10 @@ int score_matches_command(const ScoreMatchesOptions& o) {
   const auto pairs = load_pairs(ds, o.pairs);
   ProgressLine progress("[score-matches]", o.output.quiet);
   const auto counts = eval::score_directory(ds, pairs, o.dir, o.score,
-                                            [&](int k, int n) { progress.update(k, n, "pairs"); });
+                                            [&](int k, int n) {
+                                              throw_if_interrupted();
+                                              progress.update(k, n, "pairs");
+                                            });
   progress.finish();
   eval::MatchReport report = eval::make_report(o.dataset, pairs, o.score);
   eval::MethodScores m;
