@@ -119,6 +119,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
   }
   const RunConfig scn = pick(o, variant);
   const int n = steps_to_render(o, scn);
+  const int channels = frame_channels(o, scn);
   fs::path out = o.out.empty() ? fs::path("datasets") / scn.name : fs::path(o.out);
   if (o.variants.size() > 1) out /= scn.variant;
 
@@ -157,7 +158,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
     c.R_CW = truth.commanded_R_CW();
     c.offset = u.camera.offset;
     c.rate = scn.rate;
-    c.channels = frame_channels(o, scn);
+    c.channels = channels;
     writer.add_agent(u.name, c);
     effects.emplace_back(scn.world.image, scn.seed, u.name);
   }
