@@ -30,7 +30,7 @@ struct PairsOptions {
 int pairs_command(const PairsOptions& o) {
   if (!o.out.empty() && fs::exists(o.out) && !o.force)
     throw UsageError(fmt::format("{}: already exists; pass --force to replace it", o.out));
-  const datasets::Dataset ds = load_match_dataset(o.dataset);
+  const datasets::Dataset ds = datasets::read_dataset(o.dataset);
   const std::string csv = eval::pairs_csv(load_pairs(ds, o.pairs));
   if (o.out.empty()) {
     fmt::print("{}", csv);
@@ -56,7 +56,7 @@ int score_matches_command(const ScoreMatchesOptions& o) {
   if (!fs::is_directory(o.dir)) throw UsageError(fmt::format("{}: not a directory", o.dir));
   std::optional<eval::ResultsDir> staged;
   open_match_output(o.output, staged);
-  const datasets::Dataset ds = load_match_dataset(o.dataset);
+  const datasets::Dataset ds = datasets::read_dataset(o.dataset);
   const auto pairs = load_pairs(ds, o.pairs);
   ProgressLine progress("[score-matches]", o.output.quiet);
   const auto counts = eval::score_directory(ds, pairs, o.dir, o.score,

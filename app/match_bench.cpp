@@ -50,8 +50,6 @@ void add_score_options(CLI::App* cmd, eval::ScoreOptions& o) {
       ->delimiter(',')->capture_default_str();
 }
 
-datasets::Dataset load_match_dataset(const std::string& dir) { return datasets::read_dataset(dir); }
-
 void add_match_output_options(CLI::App* cmd, MatchOutput& o) {
   cmd->add_option("--out,-o", o.out, "Results directory: scores.json, scores.csv, curves.csv, plots/");
   add_force_flag(cmd, o.force);

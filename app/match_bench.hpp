@@ -37,8 +37,6 @@ std::vector<eval::FramePair> load_pairs(const datasets::Dataset& ds, const PairC
 // --baseline-bins E1,E2,...
 void add_score_options(CLI::App* cmd, eval::ScoreOptions& options);
 
-// Loads a dataset for scoring (read_dataset; DatasetError for a bad one).
-datasets::Dataset load_match_dataset(const std::string& dir);
 
 // --out DIR, --force, --no-plots, -q. open_match_output stages DIR before any work (a
 // UsageError when it exists without --force, or gnuplot is missing without --no-plots);
