@@ -15,6 +15,7 @@
 #include "geometry/camera.hpp"
 #include "geometry/settings.hpp"
 #include "sim/control_spec.hpp"
+#include "sim/trajectory.hpp"
 #include "sim/world.hpp"
 
 namespace wingman::sim {
@@ -37,35 +38,55 @@ std::vector<Sensor> sensors_of(Config c);
 enum class MeasurementMode { Synthetic, Rendered };
 const char* to_string(MeasurementMode m);
 
-// Lead trajectory of eq. 66, shifted so that it starts at `initial_position`.
+// The lead's path (docs/scenario.md, trajectories): the lemniscate of eq. 66, a line of constant
+// velocity, timed waypoints, or a TUM or CSV trajectory file; shifted so that it starts at
+// lead.initial_position (which defaults to the path's own start for waypoints and files).
 struct LeadTrajectorySpec {
-  std::string type = "lemniscate";  // or "line": constant velocity
+  std::string type = "lemniscate";  // line, waypoints, file
   double scale = 100.0;      // m
   double omega = 0.015;      // rad/s, of the planar lemniscate
   double z_amplitude = 2.0;  // m
   double z_omega = 0.03;     // rad/s
   Eigen::Vector3d velocity{1.5, 0, 0};  // m/s, of the line
+  Waypoints waypoints{};                // [t, x, y, z] rows, of `waypoints`
+  std::string file;                     // of `file`: next to the scenario, or absolute
+  std::string format = "auto";          // tum, csv, or auto: by the file's extension
+  SplineEnds ends = SplineEnds::Rest;   // of the spline through waypoints or file samples
+  // The spline of `waypoints` or `file`, built by the loader (immutable, shared by copies).
+  std::shared_ptr<const SplinePath> path;
 
   template <class V>
   void visit(V& v) {
-    v.choice("type", type, {{"lemniscate", std::string("lemniscate")}, {"line", std::string("line")}});
+    v.choice("type", type, {{"lemniscate", std::string("lemniscate")}, {"line", std::string("line")},
+                            {"waypoints", std::string("waypoints")}, {"file", std::string("file")}});
     v("scale", scale);
     v("omega", omega);
     v("z_amplitude", z_amplitude);
     v("z_omega", z_omega);
     v("velocity", velocity);
+    v("waypoints", waypoints);
+    v("file", file);
+    v.choice("format", format, {{"auto", std::string("auto")}, {"tum", std::string("tum")}, {"csv", std::string("csv")}});
+    v.choice("ends", ends, {{"rest", SplineEnds::Rest}, {"natural", SplineEnds::Natural}});
   }
+  bool spline() const { return type == "waypoints" || type == "file"; }
 };
+
+// Open-loop UAVs keep their initial offset from the lead in the world frame, or in the lead's
+// heading frame: a formation that turns with the lead's direction of travel.
+enum class FormationFrame { World, Heading };
 
 struct LeadSpec {
   Eigen::Vector3d initial_position{0, 0, 0};
   LeadTrajectorySpec trajectory{};
   bool gps = true;  // the lead carries the GPS (eq. 7)
+  FormationFrame formation_frame = FormationFrame::World;
 
   template <class V>
   void visit(V& v) {
     v("initial_position", initial_position);
     v("gps", gps);
+    v.choice("formation_frame", formation_frame, {{"world", FormationFrame::World}, {"heading", FormationFrame::Heading}});
     v.section("trajectory", [&](auto& t) { trajectory.visit(t); });
   }
 };

@@ -106,6 +106,7 @@ struct Provenance {
   std::vector<Loc> phase_to;      // per phase, its `to` value
   std::vector<Loc> outage_agent;  // per outage, its `agent` value (invalid when absent)
   KeyLocations keys;              // size-driving keys as set: "duration", "landmarks.density", ...
+  Loc control_uavs;               // control.uavs, or the control section, if given
 };
 
 // Where a key was set, or its path marked as a default.
@@ -275,21 +276,8 @@ void parse_control_uavs(const Ctx& ctx, const Field& f, std::vector<UavControlSp
 
 // The section's presence turns the closed loop on; every UAV of the scenario needs an entry
 // (default: section 7.3's uav1 and uav2).
-void parse_control(const Ctx& ctx, const Field& f, ControlSpec& c, const std::vector<UavSpec>& uavs) {
-  // The controller's keys (gains, switching, limits) are control::SlidingModeSettings', checked
-  // and read by app/ from settings_layers; these are the truth's and the evaluation's.
-  const MapView m = MapView::open(ctx, f);
-  c.enabled = true;
-  num(ctx, m, "settling_time", c.settling_time, ge(0));
-  if (auto df = m.get("disturbance")) {
-    MapView d(ctx, *df, {"bound", "seed"});
-    set_if(d, "bound", c.disturbance_bound, [&](const Field& x) { return read_vec4(ctx, x, ge(0)); });
-    if (auto s = d.get("seed")) c.disturbance_seed = read_seed(ctx, *s);
-  }
-  const auto uf = m.get("uavs");
-  if (uf) parse_control_uavs(ctx, *uf, c.uavs);
-  else if (c.uavs.empty()) c.uavs = paper_control_uavs();
-  const Loc where = uf ? uf->loc() : f.key_loc();
+// Every controlled UAV is a UAV of the scenario and every UAV is controlled.
+void check_control_uavs(const Ctx& ctx, const ControlSpec& c, const std::vector<UavSpec>& uavs, const Loc& where) {
   for (const UavControlSpec& u : c.uavs) {
     const bool known = std::any_of(uavs.begin(), uavs.end(), [&](const UavSpec& s) { return s.name == u.uav; });
     if (!known) {
@@ -305,12 +293,32 @@ void parse_control(const Ctx& ctx, const Field& f, ControlSpec& c, const std::ve
   }
 }
 
+void parse_control(const Ctx& ctx, const Field& f, ControlSpec& c, const std::vector<UavSpec>& uavs,
+                   Provenance& prov) {
+  // The controller's keys (gains, switching, limits) are control::SlidingModeSettings', checked
+  // and read by app/ from settings_layers; these are the truth's and the evaluation's.
+  const MapView m = MapView::open(ctx, f);
+  c.enabled = true;
+  num(ctx, m, "settling_time", c.settling_time, ge(0));
+  if (auto df = m.get("disturbance")) {
+    MapView d(ctx, *df, {"bound", "seed"});
+    set_if(d, "bound", c.disturbance_bound, [&](const Field& x) { return read_vec4(ctx, x, ge(0)); });
+    if (auto s = d.get("seed")) c.disturbance_seed = read_seed(ctx, *s);
+  }
+  const auto uf = m.get("uavs");
+  if (uf) parse_control_uavs(ctx, *uf, c.uavs);
+  else if (c.uavs.empty()) c.uavs = paper_control_uavs();
+  prov.control_uavs = uf ? uf->loc() : f.key_loc();
+  check_control_uavs(ctx, c, uavs, prov.control_uavs);
+}
+
 // The sections a variant may override; the top level parses them with the same code.
-const std::vector<std::string_view> kCommonKeys = {"seed",      "duration", "noise",   "landmarks",
+const std::vector<std::string_view> kCommonKeys = {"uavs", "seed", "duration", "noise",   "landmarks",
                                                    "phases",    "outages",  "estimator", "control",
                                                    "frontend"};
 
 void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& prov) {
+  if (auto f = m.get("uavs")) parse_uavs(ctx, *f, s.uavs, prov);
   if (auto f = m.get("seed")) s.seed = read_seed(ctx, *f);
   num(ctx, m, "duration", s.duration, gt(0));
   if (auto f = m.get("duration")) prov.keys["duration"] = f->loc();
@@ -318,7 +326,7 @@ void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& pro
   if (auto f = m.get("landmarks")) read_settings(ctx, *f, s.field, &prov.keys);
   if (auto f = m.get("phases")) parse_phases(ctx, *f, s.phases, prov);
   if (auto f = m.get("outages")) parse_outages(ctx, *f, s.outages, prov);
-  if (auto f = m.get("control")) parse_control(ctx, *f, s.control, s.uavs);
+  if (auto f = m.get("control")) parse_control(ctx, *f, s.control, s.uavs, prov);
   for (std::string_view key : {"estimator", "control", "frontend"})
     if (auto f = m.get(key))
       s.settings_layers.push_back(std::make_shared<const SettingsLayer>(SettingsLayer{std::string(key), ctx, *f}));
@@ -345,7 +353,8 @@ void check_budget(const Ctx& ctx, const Scenario& s, const Provenance& prov) {
   for (std::size_t i = 0; i < s.uavs.size(); ++i)
     check_position(s.uavs[i].initial_position, fmt::format("uavs[{}].initial_position", i));
   const RunEstimate e = estimate_run(s);
-  const std::string traj = s.lead.trajectory.type == "line" ? "velocity" : "scale";
+  const std::string& type = s.lead.trajectory.type;
+  const std::string traj = type == "line" ? "velocity" : type == "waypoints" ? "waypoints" : type == "file" ? "file" : "scale";
   if (!(e.extent_m <= 2 * L::kMaxCoordinate))
     ctx.fail(key_loc(prov, "lead.trajectory." + traj),
              fmt::format("the flight spans {:.3g} m; at most {:.3g}", e.extent_m, 2 * L::kMaxCoordinate));
@@ -378,8 +387,47 @@ void check_budget(const Ctx& ctx, const Scenario& s, const Provenance& prov) {
                          duration_text(e.seconds), steps, duration_text(L::kMaxSeconds)));
 }
 
+// The spline of a `waypoints` or `file` trajectory; its start is the lead's initial position
+// unless the scenario sets one.
+void build_lead_path(const Ctx& ctx, Scenario& s, const Provenance& prov) {
+  LeadTrajectorySpec& tr = s.lead.trajectory;
+  if (!tr.spline()) {
+    for (const char* key : {"waypoints", "file"})
+      if (auto it = prov.keys.find(std::string("lead.trajectory.") + key); it != prov.keys.end())
+        ctx.fail(it->second, fmt::format("is used by type {}; this trajectory's type is {}", key, tr.type));
+    return;
+  }
+  const Loc type_loc = key_loc(prov, "lead.trajectory.type");
+  std::vector<TrajectorySample> samples;
+  if (tr.type == "waypoints") {
+    if (tr.waypoints.rows.empty()) ctx.fail(type_loc, "type waypoints needs a list `waypoints` of [t, x, y, z]");
+    for (const auto& r : tr.waypoints.rows) samples.push_back({r[0], r.tail<3>(), std::nullopt});
+  } else {
+    if (tr.file.empty()) ctx.fail(type_loc, "type file needs `file`: a TUM or CSV trajectory");
+    const Loc file_loc = key_loc(prov, "lead.trajectory.file");
+    std::optional<TrajectoryFormat> format = tr.format == "tum"   ? TrajectoryFormat::Tum
+                                             : tr.format == "csv" ? TrajectoryFormat::Csv
+                                                                  : format_from_extension(tr.file);
+    if (!format)
+      ctx.fail(file_loc, fmt::format("'{}': cannot tell its format from the extension (.tum, .txt, .csv); set "
+                                     "lead.trajectory.format to tum or csv", tr.file));
+    std::filesystem::path path(tr.file);
+    if (path.is_relative()) path = std::filesystem::path(ctx.origin()).parent_path() / path;
+    try {
+      samples = read_trajectory_file(path.lexically_normal().string(), *format);
+    } catch (const TrajectoryFileError& e) {
+      ctx.fail(file_loc, e.what());
+    }
+  }
+  tr.path = std::make_shared<const SplinePath>(samples, tr.ends);
+  if (!prov.keys.count("lead.initial_position")) s.lead.initial_position = tr.path->at(0).position;
+}
+
 // Defaults that depend on other fields, then the checks that involve the whole scenario.
 void finalise(const Ctx& ctx, Scenario& s, const Provenance& prov) {
+  build_lead_path(ctx, s, prov);
+  // A variant's own uavs against the control section it inherits.
+  if (s.control.enabled) check_control_uavs(ctx, s.control, s.uavs, prov.uavs.valid() ? prov.uavs : prov.control_uavs);
   if (!prov.phases_given) {
     Phase all;
     all.name = "all";
@@ -457,7 +505,6 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
                              "unknown measurement mode '{}' (expected 'synthetic' or 'rendered')", s));
   }
   if (auto f = top.get("lead")) read_settings(ctx, *f, base.lead, &prov.keys);
-  if (auto f = top.get("uavs")) parse_uavs(ctx, *f, base.uavs, prov);
   if (auto f = top.get("world")) read_settings(ctx, *f, base.world, &prov.keys);
   apply_common(ctx, top, base, prov);
 

@@ -16,6 +16,7 @@
 
 #include "geometry/camera.hpp"
 #include "geometry/settings.hpp"
+#include "sim/trajectory.hpp"
 #include "sim/yaml_input.hpp"
 
 namespace wingman::sim {
@@ -94,6 +95,9 @@ class Reader {
   }
   void operator()(std::string_view key, Eigen::Vector4d& x, geometry::Bounds b = {}) {
     if (auto f = get(key)) x = read_vec4(ctx_, *f, b);
+  }
+  void operator()(std::string_view key, Waypoints& x) {
+    if (auto f = get(key)) x = read_waypoints(ctx_, *f);
   }
   template <typename E>
   void choice(std::string_view key, E& x, geometry::Choices<E> choices) {
@@ -184,6 +188,11 @@ class Emitter {
       out_ << "per_run";
     else
       out_ << s.value;
+  }
+  void put(const Waypoints& w) {
+    out_ << YAML::BeginSeq;
+    for (const auto& r : w.rows) emit_numbers(out_, r);
+    out_ << YAML::EndSeq;
   }
   void put(const geometry::Distortion& d) { put(Eigen::Matrix<double, 5, 1>(d.k1, d.k2, d.p1, d.p2, d.k3)); }
   template <int N>

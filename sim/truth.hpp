@@ -1,5 +1,6 @@
-// Ground-truth motion of the open-loop runs: the lead follows the lemniscate of paper eq. 66 (or a
-// straight line) and every UAV the same curve shifted by its initial offset (docs/design.md, frames and conventions), each
+// Ground-truth motion of the open-loop runs: the lead follows its curve (the lemniscate of paper
+// eq. 66, a line, waypoints or a file) and every UAV keeps its initial offset from it, in the
+// world frame or turning with the lead's heading (docs/design.md, frames and conventions), each
 // agent plus the random acceleration of noise.motion when the scenario asks for it; the cameras carry the
 // gimbal error e_r(t) = A sin(w t) about their x and y axes (or with a phase per camera and
 // axis, noise.gimbal_random_phase), which the filter never sees.
@@ -14,17 +15,18 @@
 
 namespace wingman::sim {
 
-struct KinematicState {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero(), velocity = Eigen::Vector3d::Zero();
-  // The curve's second derivative (an IMU's specific force comes from it); zero where a truth
-  // does not know it (the closed loop's discrete steps).
-  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
-};
-
-// eq. 66 and its first two time derivatives, unshifted.
+// eq. 66 and its first three time derivatives, unshifted (the third by central differences of
+// the analytic second).
 KinematicState lemniscate(const LeadTrajectorySpec& spec, double t);
-// The curve the scenario names (lemniscate or line), unshifted.
+// The curve the scenario names (lemniscate, line, or the spline of waypoints or a file), unshifted.
 KinematicState nominal_motion(const LeadTrajectorySpec& spec, double t);
+
+// The direction of travel of a curve about world z, and its first two time derivatives.
+struct Turn {
+  double heading = 0, rate = 0, acceleration = 0;
+};
+// At a standstill: the heading the curve leaves with (or, at its end, arrived with), turning at 0.
+Turn curve_turn(const LeadTrajectorySpec& spec, double t);
 
 // What the synthetic measurements are made from: the lead, the UAVs and their cameras. The
 // open-loop truth knows every instant in advance; the closed-loop one only the current step.
@@ -62,8 +64,11 @@ class OpenLoopTruth : public Truth {
  private:
   // Agent a (0: lead, 1 + j: UAV j): the curve shifted to start at `start`, plus its deviation.
   KinematicState agent(std::size_t a, const Eigen::Vector3d& start, double t) const;
+  // UAV j's offset from the lead at t and its derivatives (constant in the world frame).
+  KinematicState formation_offset(int j, double t) const;
 
   Eigen::Vector3d origin_;  // the curve's value at t = 0
+  double heading0_ = 0;     // the curve's heading at t = 0
   // Per agent, per step k = 0..num_steps: the integrated noise.motion acceleration; empty when
   // the scenario has none.
   std::vector<std::vector<KinematicState>> wander_;

@@ -329,6 +329,23 @@ Eigen::Vector4d read_vec4(const Ctx& ctx, const Field& f, Bounds b) {
   return read_list<4>(ctx, f, b, true, "a number or a list of 4 numbers (x, y, z, yaw)");
 }
 
+Waypoints read_waypoints(const Ctx& ctx, const Field& f) {
+  if (!f.node.IsSequence() || f.node.size() < 2)
+    ctx.fail(f.loc(), fmt::format("expected a list of at least 2 waypoints [t, x, y, z], got {}",
+                                  f.node.IsSequence() ? fmt::format("a list of {}", f.node.size()) : describe(f.node)));
+  Waypoints w;
+  for (std::size_t i = 0; i < f.node.size(); ++i) {
+    const Field row{f.node[i], f.key_mark, index_path(f.path, i)};
+    const Eigen::Vector4d r = read_list<4>(ctx, row, any_value(), false, "a waypoint [t, x, y, z]");
+    if (r[0] < 0) ctx.fail(row.loc(), fmt::format("time {} is negative; times are seconds from the start", r[0]));
+    if (!w.rows.empty() && !(r[0] > w.rows.back()[0]))
+      ctx.fail(row.loc(), fmt::format("time {} is not after the previous waypoint's ({}); waypoints must be "
+                                      "in increasing time order", r[0], w.rows.back()[0]));
+    w.rows.push_back(r);
+  }
+  return w;
+}
+
 }  // namespace wingman::sim
 
 namespace wingman::sim::settings_detail {

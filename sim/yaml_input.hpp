@@ -18,6 +18,7 @@
 
 #include "geometry/camera.hpp"
 #include "geometry/settings.hpp"
+#include "sim/trajectory.hpp"
 
 namespace wingman::sim {
 
@@ -116,5 +117,7 @@ Eigen::Vector3d read_vec3(const Ctx& ctx, const Field& f, Bounds b = any_value()
 geometry::Distortion read_distortion(const Ctx& ctx, const Field& f);
 // A list of 4 numbers, each within b.
 Eigen::Vector4d read_vec4(const Ctx& ctx, const Field& f, Bounds b = any_value());
+// Timed waypoints [t, x, y, z]: at least two, times >= 0 and strictly increasing.
+Waypoints read_waypoints(const Ctx& ctx, const Field& f);
 
 }  // namespace wingman::sim
