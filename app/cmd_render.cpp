@@ -196,7 +196,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
   progress.finish();
   for (int j = 0; j < cams; ++j) write_inertial(writer, truth, scn, j, n * scn.dt());
   writer.finish();
-  fs::copy_file(o.scenario, staged->staging() / "scenario.yaml");
+  copy_scenario(scn, staged->staging());
   staged->commit();
   if (!o.quiet)
     fmt::print("dataset: {} ({} steps x {} cameras, {})\n", out.string(), n + 1, cams,

@@ -118,7 +118,7 @@ int run_command(const RunOptions& o) {
       }
     }
   }
-  fs::copy_file(o.scenario, results.staging() / "scenario.yaml");
+  copy_scenario(scenarios.front(), results.staging());
   results.commit();
   if (!o.quiet) fmt::print("results: {}\n", out.string());
   return 0;

@@ -66,7 +66,7 @@ int slam_command(const SlamOptions& o, const std::string& variant) {
   const eval::Metrics metrics = eval::compute_metrics(rec);
   eval::write_results(metrics, rec, staged->staging());
   if (!o.no_plots) eval::write_plots(rec, staged->staging());
-  fs::copy_file(scn_path, staged->staging() / "scenario.yaml");
+  copy_scenario(scn, staged->staging());
   staged->commit();
   if (!o.quiet) fmt::print("{}\nresults: {}\n", eval::format_summary(metrics, rec), out.string());
   return 0;

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "app/interrupt.hpp"
+#include "app/shared_view.hpp"
 #include "app/timing.hpp"
 #include "app/version.hpp"
 #include "sim/rng.hpp"
@@ -229,19 +230,15 @@ void Run::initialise(double t, int phase, StepCounts& n, StepTimes& tm) {
   tm.init = ms_since(t0) - (tm.match - match0);
 }
 
-// Each camera pairs with the next; a pair asks for the larger deficit of its two cameras.
+// Every pair of cameras that shares view, most shared first; a pair asks for the larger deficit
+// its two cameras still have after the pairs before it.
 void Run::initialise_pairs(double t, int phase, std::vector<int>& added, StepCounts& n, StepTimes& tm) {
   const int target = cfg_.estimator.map.target_per_camera;
-  std::map<std::pair<int, int>, int> pairs;
-  for (int j = 0; j < cameras(); ++j) {
-    const int o = (j + 1) % cameras();
-    const int need = target - in_view_[j];
-    if (o == j || need <= 0 || !sees_[j] || !sees_[o]) continue;
-    auto key = std::minmax(j, o);
-    pairs[key] = std::max(pairs[key], need);
-  }
+  auto deficit = [&](int j) { return target - in_view_[j] - added[j]; };
   eval::OutlierCounts& coop = rec.outliers.back();
-  for (const auto& [pr, need] : pairs) {
+  for (const auto& pr : pairs_sharing_view(est, sees_)) {
+    const int need = std::max(deficit(pr.first), deficit(pr.second));
+    if (need <= 0) continue;
     const auto tm0 = Clock::now();
     const auto found = src_.pairs(pr.first, pr.second, need, est);
     tm.match += ms_since(tm0);

@@ -76,6 +76,15 @@ void resolve_estimator(RunConfig& cfg, const Provenance& prov) {
     fail_at(prov, cfg, mode,
             "closed loop (the control: section) needs mode multi: the controller of every UAV takes "
             "its position from the estimator");
+  if (e.map.max_landmarks == 0) {
+    const int cameras = static_cast<int>(cfg.filter_uavs().size());
+    e.map.max_landmarks = e.map.max_landmarks_per_camera * cameras;
+    // The covariance grows as (6 max_landmarks)^2 doubles: the same bound as an explicit cap's.
+    if (e.map.max_landmarks > 2000)
+      fail_at(prov, cfg, prov.find("estimator", "map.max_landmarks_per_camera"),
+              fmt::format("{} per camera for {} cameras is {} landmarks; at most 2000 (set max_landmarks)",
+                          e.map.max_landmarks_per_camera, cameras, e.map.max_landmarks));
+  }
   if (e.map.target_per_camera > e.map.max_landmarks) {
     if (const auto* t = prov.find("estimator", "map.target_per_camera"))
       fail_at(prov, cfg, t, fmt::format("must not exceed max_landmarks ({}), got {}", e.map.max_landmarks,
@@ -266,6 +275,17 @@ void limit_duration(RunConfig& cfg, double duration) {
   };
   cut(cfg.phases);
   cut(cfg.outages);
+}
+
+void copy_scenario(const sim::Scenario& scn, const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  fs::copy_file(scn.source_path, dir / "scenario.yaml");
+  const auto& tr = scn.lead.trajectory;
+  if (tr.type != "file") return;
+  const fs::path rel = fs::path(tr.file.value).lexically_normal();
+  if (rel.is_absolute() || rel.empty() || *rel.begin() == "..") return;
+  fs::create_directories((dir / rel).parent_path());
+  fs::copy_file(fs::path(scn.source_path).parent_path() / rel, dir / rel);
 }
 
 }  // namespace wingman::app

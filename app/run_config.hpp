@@ -38,6 +38,10 @@ RunConfig compose(const sim::Scenario& scenario);
 std::string config_yaml(const RunConfig& cfg);
 // Writes config_yaml(cfg) to `path`; throws std::runtime_error naming it when it cannot.
 void write_config(const RunConfig& cfg, const std::filesystem::path& path);
+// Copies the scenario file a run came from into dir as scenario.yaml, with the trajectory file its
+// lead follows when the scenario names it by a path inside its own directory, so that the copy
+// loads the same (a replay of a dataset reads its scenario.yaml).
+void copy_scenario(const sim::Scenario& scn, const std::filesystem::path& dir);
 
 // Cuts a run to its first `duration` seconds: phases and outages that start later are dropped,
 // the others end there at the latest.

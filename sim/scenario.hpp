@@ -49,7 +49,7 @@ struct LeadTrajectorySpec {
   double z_omega = 0.03;     // rad/s
   Eigen::Vector3d velocity{1.5, 0, 0};  // m/s, of the line
   Waypoints waypoints{};                // [t, x, y, z] rows, of `waypoints`
-  std::string file;                     // of `file`: next to the scenario, or absolute
+  OptionalPath file;                    // of `file`: next to the scenario, or absolute
   std::string format = "auto";          // tum, csv, or auto: by the file's extension
   SplineEnds ends = SplineEnds::Rest;   // of the spline through waypoints or file samples
   // The spline of `waypoints` or `file`, built by the loader (immutable, shared by copies).

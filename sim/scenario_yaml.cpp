@@ -392,9 +392,11 @@ void check_budget(const Ctx& ctx, const Scenario& s, const Provenance& prov) {
 void build_lead_path(const Ctx& ctx, Scenario& s, const Provenance& prov) {
   LeadTrajectorySpec& tr = s.lead.trajectory;
   if (!tr.spline()) {
+    // Given, but for another type (the resolved settings print them empty).
     for (const char* key : {"waypoints", "file"})
-      if (auto it = prov.keys.find(std::string("lead.trajectory.") + key); it != prov.keys.end())
-        ctx.fail(it->second, fmt::format("is used by type {}; this trajectory's type is {}", key, tr.type));
+      if ((key[0] == 'w' ? !tr.waypoints.rows.empty() : !tr.file.empty()))
+        ctx.fail(key_loc(prov, std::string("lead.trajectory.") + key),
+                 fmt::format("is used by type {}; this trajectory's type is {}", key, tr.type));
     return;
   }
   const Loc type_loc = key_loc(prov, "lead.trajectory.type");
@@ -407,11 +409,11 @@ void build_lead_path(const Ctx& ctx, Scenario& s, const Provenance& prov) {
     const Loc file_loc = key_loc(prov, "lead.trajectory.file");
     std::optional<TrajectoryFormat> format = tr.format == "tum"   ? TrajectoryFormat::Tum
                                              : tr.format == "csv" ? TrajectoryFormat::Csv
-                                                                  : format_from_extension(tr.file);
+                                                                  : format_from_extension(tr.file.value);
     if (!format)
       ctx.fail(file_loc, fmt::format("'{}': cannot tell its format from the extension (.tum, .txt, .csv); set "
-                                     "lead.trajectory.format to tum or csv", tr.file));
-    std::filesystem::path path(tr.file);
+                                     "lead.trajectory.format to tum or csv", tr.file.value));
+    std::filesystem::path path(tr.file.value);
     if (path.is_relative()) path = std::filesystem::path(ctx.origin()).parent_path() / path;
     try {
       samples = read_trajectory_file(path.lexically_normal().string(), *format);

@@ -96,6 +96,10 @@ class Reader {
   void operator()(std::string_view key, Eigen::Vector4d& x, geometry::Bounds b = {}) {
     if (auto f = get(key)) x = read_vec4(ctx_, *f, b);
   }
+  void operator()(std::string_view key, OptionalPath& x) {
+    auto f = get(key);
+    if (f) x.value = f->node.IsScalar() && f->node.Scalar().empty() ? std::string() : read_string(ctx_, *f);
+  }
   void operator()(std::string_view key, Waypoints& x) {
     if (auto f = get(key)) x = read_waypoints(ctx_, *f);
   }
@@ -189,6 +193,7 @@ class Emitter {
     else
       out_ << s.value;
   }
+  void put(const OptionalPath& p) { out_ << YAML::DoubleQuoted << p.value; }
   void put(const Waypoints& w) {
     out_ << YAML::BeginSeq;
     for (const auto& r : w.rows) emit_numbers(out_, r);

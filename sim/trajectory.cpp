@@ -70,15 +70,14 @@ SplinePath::SplinePath(const std::vector<TrajectorySample>& samples, SplineEnds 
 
 KinematicState SplinePath::at(double t) const {
   KinematicState k;
-  if (t <= t_.front()) {
-    k.position = a_.front();
+  // Before the first sample and after the last the path holds still; at either sample itself it
+  // moves as the spline does (a natural end's velocity is not zero there).
+  if (t < t_.front() || t > t_.back()) {
+    k.position = t < t_.front() ? samples_.front().position : samples_.back().position;
     return k;
   }
-  if (t >= t_.back()) {
-    k.position = samples_.back().position;
-    return k;
-  }
-  const std::size_t i = static_cast<std::size_t>(std::upper_bound(t_.begin(), t_.end(), t) - t_.begin()) - 1;
+  const auto seg = std::upper_bound(t_.begin(), t_.end(), t) - t_.begin() - 1;
+  const std::size_t i = std::min(static_cast<std::size_t>(seg), a_.size() - 1);
   const double s = t - t_[i];
   k.position = a_[i] + s * (b_[i] + s * (c_[i] + s * d_[i]));
   k.velocity = b_[i] + s * (2 * c_[i] + 3 * s * d_[i]);

@@ -35,6 +35,12 @@ struct Waypoints {
   std::vector<Eigen::Vector4d> rows;
 };
 
+// A file path that may be empty (no file): a trajectory other than `file` prints it as "".
+struct OptionalPath {
+  std::string value;
+  bool empty() const { return value.empty(); }
+};
+
 // How the spline ends: at rest (zero velocity at the first and last sample, so that waiting
 // there before and after is smooth) or natural (zero acceleration there).
 enum class SplineEnds { Rest, Natural };

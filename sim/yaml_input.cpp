@@ -330,7 +330,8 @@ Eigen::Vector4d read_vec4(const Ctx& ctx, const Field& f, Bounds b) {
 }
 
 Waypoints read_waypoints(const Ctx& ctx, const Field& f) {
-  if (!f.node.IsSequence() || f.node.size() < 2)
+  // An empty list is no waypoints (what the resolved settings print for other trajectories).
+  if (!f.node.IsSequence() || f.node.size() == 1)
     ctx.fail(f.loc(), fmt::format("expected a list of at least 2 waypoints [t, x, y, z], got {}",
                                   f.node.IsSequence() ? fmt::format("a list of {}", f.node.size()) : describe(f.node)));
   Waypoints w;

@@ -105,7 +105,10 @@ struct GatingSettings {
 };
 
 struct MapSettings {
-  int max_landmarks = 150;
+  // The filter's map holds at most max_landmarks; 0: max_landmarks_per_camera for each camera in
+  // the filter, so that the cap grows with the team (the run's configuration resolves it).
+  int max_landmarks = 0;
+  int max_landmarks_per_camera = 75;
   int target_per_camera = 25;  // new landmarks while a camera sees fewer
   int max_misses = 5;          // consecutive predicted-visible frames without an accepted match
   double image_margin_px = 10.0;
@@ -113,7 +116,8 @@ struct MapSettings {
   template <class V>
   void visit(V& v) {
     // The filter's covariance grows as (6 max_landmarks)^2 doubles: 2000 is 1.2 GB a copy.
-    v("max_landmarks", max_landmarks, in(1, 2000));
+    v("max_landmarks", max_landmarks, in(0, 2000));
+    v("max_landmarks_per_camera", max_landmarks_per_camera, in(1, 2000));
     v("target_per_camera", target_per_camera, in(1, 2000));
     v("max_misses", max_misses, ge(1));
     v("image_margin_px", image_margin_px, ge(0));

@@ -327,7 +327,7 @@ uavs:
   EXPECT_THAT(error_of("measurements: photos\n"),
               HasSubstr("scn.yaml:1:15: measurements: unknown measurement mode 'photos'"));
   EXPECT_THAT(error_of("lead: {trajectory: {type: circle}}\n"),
-              HasSubstr("lead.trajectory.type: expected one of lemniscate, line, got 'circle'"));
+              HasSubstr("lead.trajectory.type: expected one of lemniscate, line, waypoints, file, got 'circle'"));
   EXPECT_THAT(error_of("noise: {motion: {accel_sigma_lead: -0.1}}\n"),
               HasSubstr("noise.motion.accel_sigma_lead: must be in [0, 100], got -0.1"));
   EXPECT_THAT(error_of("noise: {motion: {accel_sigma: 0.1}}\n"),
@@ -376,8 +376,8 @@ estimator:
               HasSubstr("estimator.initialisation.min_depth_m: must be >= 0, got -1"));
   EXPECT_THAT(error_of("estimator: {initialisation: {low_parallax_inverse_depth: 2}}\n"),
               HasSubstr("expected true or false, got '2'"));
-  EXPECT_THAT(error_of("estimator: {map: {max_landmarks: 0}}\n"),
-              HasSubstr("estimator.map.max_landmarks: must be in [1, 2000], got 0"));
+  EXPECT_THAT(error_of("estimator: {map: {max_landmarks: -1}}\n"),
+              HasSubstr("estimator.map.max_landmarks: must be in [0, 2000], got -1"));
   EXPECT_THAT(error_of("estimator: {map: {max_misses: 99999999999}}\n"),
               HasSubstr("estimator.map.max_misses: must be at most 2147483647"));
   EXPECT_THAT(error_of("estimator: {gating: {ransac_max_hypotheses: 0}}\n"),
@@ -450,7 +450,7 @@ variants:
             "'estimator'?)");
   EXPECT_THAT(error_of("variants:\n  - {name: a, rate: 5}\n"),
               HasSubstr("scn.yaml:2:15: variants[0].rate: unknown key 'rate' (a variant may set "
-                        "only name, seed, duration"));
+                        "only name, uavs, seed, duration"));
   EXPECT_THAT(error_of("variants:\n  - {name: a}\n  - {name: a}\n"),
               HasSubstr("scn.yaml:3:12: variants[1].name: duplicate variant name 'a' (first at "
                         "line 2)"));
