@@ -26,6 +26,7 @@
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene.hpp"
+#include "sim/assets.hpp"
 #include "sim/rng.hpp"
 #include "sim/imu.hpp"
 #include "sim/scenario.hpp"
@@ -52,6 +53,8 @@ struct RenderOptions {
 
 RunConfig pick(const RenderOptions& o, const std::string& variant) {
   RunConfig scn = select_variant(load_run_configs(o.scenario), variant, o.scenario);
+  // A scenario of synthetic measurements is checked on loading without its world's files.
+  sim::check_world_files(scn);
   if (o.seed) scn.seed = *o.seed;
   return scn;
 }

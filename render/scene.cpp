@@ -15,11 +15,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "sim/assets.hpp"
 #include "sim/rng.hpp"
-
-#ifndef WINGMAN_ASSETS_DIR
-#define WINGMAN_ASSETS_DIR "assets"
-#endif
 
 namespace fs = std::filesystem;
 
@@ -43,25 +40,6 @@ void Mesh::append(const Mesh& m) {
   uvs.insert(uvs.end(), m.uvs.begin(), m.uvs.end());
   colours.insert(colours.end(), m.colours.begin(), m.colours.end());
   for (auto i : m.indices) indices.push_back(base + i);
-}
-
-std::string resolve_asset(const std::string& path, const std::string& scenario_path,
-                          const std::string& what) {
-  const fs::path p(path);
-  std::error_code ec;
-  if (p.is_absolute()) {
-    if (fs::is_regular_file(p, ec)) return p.string();
-    throw std::runtime_error(what + " '" + path + "': file not found");
-  }
-  std::vector<fs::path> candidates;
-  if (!scenario_path.empty()) candidates.push_back(fs::path(scenario_path).parent_path() / p);
-  candidates.push_back(fs::path(WINGMAN_ASSETS_DIR) / p);
-  std::string looked;
-  for (const auto& c : candidates) {
-    if (fs::is_regular_file(c, ec)) return c.lexically_normal().string();
-    looked += (looked.empty() ? "" : ", ") + c.lexically_normal().string();
-  }
-  throw std::runtime_error(what + " '" + path + "': file not found (looked at " + looked + ")");
 }
 
 namespace {
@@ -442,7 +420,7 @@ Scene build_scene(const sim::WorldDescription& world) {
   ground.trilinear = w.texture.filter == sim::TextureSpec::Filter::Trilinear;
   double tex_w = w.texture.tile_size, tex_h = w.texture.tile_size;
   if (w.texture.type == sim::TextureSpec::Type::Image) {
-    const std::string p = resolve_asset(w.texture.image, world.scenario_path, "ground texture");
+    const std::string p = sim::resolve_asset(w.texture.image, world.scenario_path, "ground texture");
     ground.texture = read_image_rgb(p, "ground texture");
     ground.repeat = w.texture.mode == sim::TextureSpec::Mode::Tiled;
     // Keep the image's aspect ratio: tile_size is its width.
@@ -464,7 +442,7 @@ Scene build_scene(const sim::WorldDescription& world) {
     scene.static_meshes.push_back(
         objects_mesh(objects, static_cast<int>(scene.materials.size()) - 1));
   }
-  load_lead_model(w.lead, resolve_asset(w.lead.model, world.scenario_path, "lead model"), ground, scene);
+  load_lead_model(w.lead, sim::resolve_asset(w.lead.model, world.scenario_path, "lead model"), ground, scene);
   return scene;
 }
 

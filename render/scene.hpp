@@ -51,11 +51,6 @@ struct Scene {
 // Pose of the lead's reference point: position in the world and heading about world z.
 using LeadPose = sim::LeadPose;
 
-// A relative asset path against the scenario file's directory, then the repository's assets/.
-// Absolute paths are used as they are. Throws std::runtime_error naming every place looked at.
-std::string resolve_asset(const std::string& path, const std::string& scenario_path,
-                          const std::string& what);
-
 // The lead model from any format assimp reads, scaled to `height`, its up axis made z, its
 // top-centre moved to the origin; with the cue on its roof. Throws std::runtime_error naming the
 // file when it is missing, not a model, or refers to a missing texture. Its materials sample their

@@ -6,10 +6,12 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geometry/camera.hpp"
@@ -260,6 +262,9 @@ struct Scenario {
   std::vector<Outage> outages;
   ControlSpec control{};  // enabled: closed loop (section 6)
   WorldSpec world{};  // what `wingman render` draws (sim/world.hpp)
+  // Where the world section named its files, by key path ("world.lead.model"): 1-based line and
+  // column; keys left at their defaults are absent (sim/assets.hpp, check_world_files).
+  std::map<std::string, std::pair<int, int>> world_file_keys;
   // The YAML of the sections other modules define (estimator:, frontend:, the controller's keys
   // of control:), the base's first and then the variant's, for app/ to read into those modules'
   // own settings structs.

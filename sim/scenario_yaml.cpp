@@ -19,6 +19,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "sim/assets.hpp"
 #include "sim/budget.hpp"
 #include "sim/scenario.hpp"
 #include "sim/settings_yaml.hpp"
@@ -508,7 +509,12 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   }
   if (auto f = top.get("lead")) read_settings(ctx, *f, base.lead, &prov.keys);
   if (auto f = top.get("world")) read_settings(ctx, *f, base.world, &prov.keys);
+  for (const char* key : {"world.texture.image", "world.lead.model"})
+    if (auto it = prov.keys.find(key); it != prov.keys.end())
+      base.world_file_keys[key] = {it->second.mark.line + 1, it->second.mark.column + 1};
   apply_common(ctx, top, base, prov);
+  // A rendered run reads these files; a missing one is bad input, found before anything runs.
+  if (base.measurements == MeasurementMode::Rendered) check_world_files(base);
 
   std::vector<Scenario> out;
   const auto vf = top.get("variants");

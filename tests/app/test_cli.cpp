@@ -361,6 +361,31 @@ TEST_F(CliTest, RenderedOnlyOutputsAreRefusedOnSyntheticScenarios) {
   }
 }
 
+// A rendered scenario whose world names a file that is not there is refused on loading, at the
+// key's line, before anything is written; so is `wingman render` of a synthetic one.
+TEST_F(CliTest, MissingWorldFilesExit2AtTheirKeyBeforeAnythingIsWritten) {
+  const fs::path model = patched_smoke("model.yaml", [](std::string& t) {
+    t.replace(t.find("measurements: synthetic"), 23, "measurements: rendered");
+    t += "world:\n  lead: {kind: ground, model: models/nope.glb}\n";
+  });
+  expect_scenario_error(model, 62, "world.lead.model: 'models/nope.glb': file not found (looked at ");
+  const fs::path image = patched_smoke("image.yaml", [](std::string& t) {
+    t.replace(t.find("measurements: synthetic"), 23, "measurements: rendered");
+    t += "world:\n  texture:\n    image: gone.jpg\n";
+  });
+  expect_scenario_error(image, 63, "world.texture.image: 'gone.jpg': file not found");
+
+  const fs::path synthetic = patched_smoke("synthetic.yaml", [](std::string& t) {
+    t += "world:\n  lead: {model: models/nope.glb}\n";
+  });
+  const fs::path out = out_dir("ds");
+  const RunResult r = run_wingman({"render", synthetic.string(), "--out", out.string(), "-q"}, tmp_.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(synthetic.string() + ":62:17: world.lead.model: 'models/nope.glb'"));
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
+}
+
 TEST_F(CliTest, BadCommandLineExits2) {
   const RunResult none = run_wingman({}, tmp_.path());
   EXPECT_EQ(none.exit_code, 2) << none.output;

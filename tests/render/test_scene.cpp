@@ -10,6 +10,7 @@
 #include "render/renderer.hpp"
 #include "render/scene.hpp"
 #include "render_test_support.hpp"
+#include "sim/assets.hpp"
 #include "sim/truth.hpp"
 
 namespace wingman::render {
@@ -119,8 +120,8 @@ TEST(Scene, RelativeAssetsResolveNextToTheScenarioFirst) {
   TempDir tmp;
   std::ofstream(tmp.path / "tex.png") << "x";
   const std::string scn_file = (tmp.path / "s.yaml").string();
-  EXPECT_EQ(resolve_asset("tex.png", scn_file, "texture"), (tmp.path / "tex.png").string());
-  EXPECT_NE(resolve_asset("aerial/freetown_drone_nadir.jpg", scn_file, "texture").find("assets"),
+  EXPECT_EQ(sim::resolve_asset("tex.png", scn_file, "texture"), (tmp.path / "tex.png").string());
+  EXPECT_NE(sim::resolve_asset("aerial/freetown_drone_nadir.jpg", scn_file, "texture").find("assets"),
             std::string::npos);
 }
 

@@ -5,6 +5,7 @@
 
 #include <tuple>
 
+#include "sim/assets.hpp"
 #include "sim/scenario.hpp"
 #include "sim/truth.hpp"
 #include "sim/world.hpp"
@@ -77,6 +78,53 @@ TEST(World, ErrorsNameFileLineAndKey) {
   EXPECT_NE(error_of("world:\n  near: 10\n  far: 5\n").find("w.yaml:3:8: world.far"), std::string::npos);
   EXPECT_NE(error_of("world:\n  lead: {aruco_id: 50}\n").find("world.lead.aruco_id: must be in [0, 49]"),
             std::string::npos);
+}
+
+// A file the world names that rendering would read is checked when a rendered scenario is loaded
+// (and by check_world_files before `wingman render` draws a synthetic one), naming line and key.
+TEST(World, MissingFilesOfARenderedWorldAreErrorsAtTheirKey) {
+  const std::string model = "measurements: rendered\nworld:\n  lead: {model: models/nope.glb}\n";
+  const std::string err = error_of(model);
+  EXPECT_EQ(err.rfind("w.yaml:3:17: world.lead.model: 'models/nope.glb': file not found (looked at ", 0), 0u)
+      << err;
+  EXPECT_NE(err.find(assets_dir() + "/models/nope.glb"), std::string::npos) << err;
+  EXPECT_EQ(error_of("measurements: rendered\nworld:\n  texture:\n    image: no/such.png\n")
+                .rfind("w.yaml:4:12: world.texture.image: 'no/such.png': file not found", 0),
+            0u);
+  // A procedural texture reads no image; the shipped defaults exist.
+  EXPECT_EQ(error_of("measurements: rendered\nworld:\n  texture: {type: procedural, image: no.png}\n"),
+            "no error");
+  EXPECT_EQ(error_of("measurements: rendered\n"), "no error");
+
+  // Synthetic measurements render nothing: the scenario loads, and the check names the same place.
+  const Scenario s = parse_scenarios("world:\n  lead: {model: models/nope.glb}\n", "w.yaml").front();
+  try {
+    check_world_files(s);
+    FAIL() << "no error";
+  } catch (const ScenarioError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("w.yaml:2:17: world.lead.model: 'models/nope.glb'", 0), 0u) << e.what();
+  }
+  Scenario d = parse_scenarios("name: x\n", "w.yaml").front();
+  d.world.texture.image = "gone.jpg";
+  try {
+    check_world_files(d);
+    FAIL() << "no error";
+  } catch (const ScenarioError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("w.yaml: world.texture.image (default): 'gone.jpg'", 0), 0u) << e.what();
+  }
+}
+
+TEST(World, FindAssetLooksNextToTheScenarioThenInAssets) {
+  const auto a = find_asset("aerial/freetown_drone_nadir.jpg", "/no/such/dir/s.yaml");
+  ASSERT_TRUE(a.path.has_value());
+  EXPECT_EQ(*a.path, assets_dir() + "/aerial/freetown_drone_nadir.jpg");
+  const std::string here = std::string(WINGMAN_SOURCE_DIR) + "/scenes/paper_rendered.yaml";
+  EXPECT_EQ(find_asset("rendered_smoke.yaml", here).path.value_or(""),
+            std::string(WINGMAN_SOURCE_DIR) + "/scenes/rendered_smoke.yaml");
+  EXPECT_EQ(find_asset(here, "").path.value_or(""), here);  // absolute: as it is
+  const auto miss = find_asset("x.png", "/d/s.yaml");
+  EXPECT_FALSE(miss.path.has_value());
+  EXPECT_EQ(miss.looked_text(), "/d/x.png, " + assets_dir() + "/x.png");
 }
 
 TEST(World, TerrainFollowsAGroundLeadAndIsSeeded) {
