@@ -386,6 +386,32 @@ TEST_F(CliTest, MissingWorldFilesExit2AtTheirKeyBeforeAnythingIsWritten) {
   EXPECT_THAT(partial_entries(tmp_.path()), ::testing::IsEmpty());
 }
 
+// A lead path and a team that cannot be flown: waypoints out of time order, a trajectory file with
+// a malformed line, no UAVs. Each exits 2 at its key's line, naming the trajectory file's own
+// line where there is one, and writes nothing.
+TEST_F(CliTest, BadTrajectoriesAndAnEmptyTeamExit2AtTheirKey) {
+  const fs::path order = patched_smoke("order.yaml", [](std::string& t) {
+    t.replace(t.find("  trajectory: {type: lemniscate"), 0,
+              "  trajectory:\n    type: waypoints\n    waypoints:\n      - [0, 0, 0, 0]\n      - [20, 30, 0, 0]\n"
+              "      - [12, 40, 0, 0]\n#");
+  });
+  expect_scenario_error(order, 18, "lead.trajectory.waypoints[2]: time 12 is not after the previous waypoint's (20)");
+  write_file(tmp_ / "track.csv", "t,x,y,z\n0,0,0,0\n1,1,0,0\n2,2,0\n");
+  const fs::path file = patched_smoke("file.yaml", [](std::string& t) {
+    t.replace(t.find("trajectory: {type: lemniscate"), 0, "trajectory: {type: file, file: track.csv}\n#");
+  });
+  expect_scenario_error(file, 13, "lead.trajectory.file: " + (tmp_ / "track.csv").string() +
+                                      ":4: expected 4 fields (t,x,y,z), got 3");
+  const fs::path empty = patched_smoke("empty.yaml", [](std::string& t) {
+    const auto from = t.find("uavs:\n"), to = t.find("\nnoise:");
+    t.replace(from, to - from, "uavs: []\n");
+  });
+  const RunResult r = run_wingman({"run", empty.string(), "--out", out_dir().string(), "-q"}, tmp_.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.output, HasSubstr(empty.string() + ":15:7: uavs: at least one UAV is needed")) << r.output;
+  EXPECT_FALSE(fs::exists(out_dir()));
+}
+
 TEST_F(CliTest, BadCommandLineExits2) {
   const RunResult none = run_wingman({}, tmp_.path());
   EXPECT_EQ(none.exit_code, 2) << none.output;
