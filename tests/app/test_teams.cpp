@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <string>
 #include <utility>
@@ -150,6 +151,26 @@ INSTANTIATE_TEST_SUITE_P(Teams, TeamRuns,
                                   (std::string(info.param.mode) == "rendered" ? "Rendered" : "Synthetic") +
                                   (info.param.closed ? "ClosedLoop" : "OpenLoop");
                          });
+
+}  // namespace
+}  // namespace wingman::app
+
+namespace wingman::app {
+namespace {
+
+// Every shipped scene loads with its modules' settings, its assets and trajectory files found.
+TEST(ShippedScenes, EverySceneLoads) {
+  int scenes = 0;
+  for (const auto& e : std::filesystem::directory_iterator(WINGMAN_SOURCE_DIR "/scenes")) {
+    if (e.path().extension() != ".yaml") continue;
+    ++scenes;
+    SCOPED_TRACE(e.path().string());
+    std::vector<RunConfig> configs;
+    EXPECT_NO_THROW(configs = load_run_configs(e.path().string()));
+    EXPECT_FALSE(configs.empty());
+  }
+  EXPECT_GE(scenes, 20);
+}
 
 }  // namespace
 }  // namespace wingman::app
