@@ -282,10 +282,12 @@ void copy_scenario(const sim::Scenario& scn, const std::filesystem::path& dir) {
   fs::copy_file(scn.source_path, dir / "scenario.yaml");
   const auto& tr = scn.lead.trajectory;
   if (tr.type != "file") return;
-  const fs::path rel = fs::path(tr.file.value).lexically_normal();
-  if (rel.is_absolute() || rel.empty() || *rel.begin() == "..") return;
+  // The loader made the path absolute; the scenario file names it relative to its folder.
+  const fs::path file(tr.file.value);
+  const fs::path rel = file.lexically_relative(fs::absolute(scn.source_path).parent_path());
+  if (rel.empty() || *rel.begin() == "..") return;
   fs::create_directories((dir / rel).parent_path());
-  fs::copy_file(fs::path(scn.source_path).parent_path() / rel, dir / rel);
+  fs::copy_file(file, dir / rel);
 }
 
 }  // namespace wingman::app

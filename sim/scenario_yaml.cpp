@@ -421,6 +421,8 @@ void build_lead_path(const Ctx& ctx, Scenario& s, const Provenance& prov) {
     } catch (const TrajectoryFileError& e) {
       ctx.fail(file_loc, e.what());
     }
+    // The resolved settings (config.yaml) then name the file wherever they are read from.
+    tr.file.value = std::filesystem::absolute(path).lexically_normal().string();
   }
   tr.path = std::make_shared<const SplinePath>(samples, tr.ends);
   if (!prov.keys.count("lead.initial_position")) s.lead.initial_position = tr.path->at(0).position;

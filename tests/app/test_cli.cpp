@@ -412,6 +412,52 @@ TEST_F(CliTest, BadTrajectoriesAndAnEmptyTeamExit2AtTheirKey) {
   EXPECT_FALSE(fs::exists(out_dir()));
 }
 
+// A run's true lead trajectory (traj/lead.gt.tum), read back as the lead's trajectory file,
+// reproduces its poses; the results keep the file next to scenario.yaml, and config.yaml runs
+// the same flight from anywhere.
+TEST_F(CliTest, TumTrajectoryReadBackReproducesTheLeadsPoses) {
+  const fs::path first = out_dir("first");
+  RunResult r = run_wingman({"run", kSmoke.string(), "--variant", "multi", "--duration", "6", "--out",
+                             first.string(), "--no-plots", "-q"}, tmp_.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  fs::create_directories(tmp_ / "scn" / "tracks");
+  fs::copy_file(first / "multi" / "traj" / "lead.gt.tum", tmp_ / "scn" / "tracks" / "lead.tum");
+  const fs::path scn = tmp_ / "scn" / "follow.yaml";
+  write_file(scn, "duration: 6\nlead: {trajectory: {type: file, file: tracks/lead.tum, ends: natural}}\n");
+  const fs::path second = out_dir("second");
+  r = run_wingman({"run", scn.string(), "--out", second.string(), "--no-plots", "-q"}, tmp_.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_file(second / "tracks" / "lead.tum"), read_file(tmp_ / "scn" / "tracks" / "lead.tum"));
+  auto poses = [](const fs::path& f) {
+    std::vector<std::vector<double>> rows;
+    std::istringstream in(read_file(f));
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream ls(line);
+      std::vector<double> v(8);
+      for (double& x : v) ls >> x;
+      rows.push_back(v);
+    }
+    return rows;
+  };
+  const auto a = poses(first / "multi" / "traj" / "lead.gt.tum"), b = poses(second / "traj" / "lead.gt.tum");
+  ASSERT_EQ(a.size(), 61u);
+  ASSERT_EQ(b.size(), a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(a[i][0], b[i][0], 1e-9) << i;
+    for (int k = 1; k <= 3; ++k) EXPECT_NEAR(a[i][k], b[i][k], 1e-6) << i << " axis " << k;
+    // The heading comes from the spline's velocity: the lemniscate's within a hundredth of a radian.
+    const double dot = std::abs(a[i][4] * b[i][4] + a[i][5] * b[i][5] + a[i][6] * b[i][6] + a[i][7] * b[i][7]);
+    EXPECT_GT(dot, std::cos(0.005)) << i << ": " << a[i][6] << " " << b[i][6];
+  }
+  // The resolved configuration names the file by its absolute path: it runs from its own folder.
+  const fs::path third = out_dir("third");
+  r = run_wingman({"run", (second / "config.yaml").string(), "--out", third.string(), "--no-plots", "-q"},
+                  tmp_.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_file(third / "traj" / "lead.gt.tum"), read_file(second / "traj" / "lead.gt.tum"));
+}
+
 TEST_F(CliTest, BadCommandLineExits2) {
   const RunResult none = run_wingman({}, tmp_.path());
   EXPECT_EQ(none.exit_code, 2) << none.output;
