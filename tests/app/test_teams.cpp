@@ -90,8 +90,13 @@ TEST(TeamPairs, MapCapGrowsWithTheTeamUnlessSet) {
   EXPECT_EQ(per.estimator.map.max_landmarks, 160);
 }
 
-// A team of n UAVs around the lead (the first carries the lead sensors), 1.5 s, with 320 x 320
-// cameras of the paper's field of view; closed: every UAV flown by the controller.
+// A team of n UAVs around the lead (the first carries the lead sensors), 1.5 s, with cameras of
+// two kinds in turn: 320 x 320 of the paper's field of view, and 400 x 300 with radial-tangential
+// distortion and a lever arm; closed: every UAV flown by the controller.
+const std::string kSquare = "{fx: 64.03, fy: 64.03, cx: 160, cy: 160, width: 320, height: 320}";
+const std::string kWide = "{fx: 90, fy: 92, cx: 201, cy: 148, width: 400, height: 300, "
+                          "distortion: [-0.05, 0.01, 0.001, -0.001], offset: [0.1, 0, -0.05]}";
+
 std::string team_yaml(int n, const std::string& mode, bool closed) {
   const double offsets[8][3] = {{-1.5, 0, 15}, {1.5, 0, 17}, {-4, 5, 16}, {4, -5, 18},
                                 {-5, -5, 16.5}, {5, 5, 15.5}, {0, 7, 17}, {0, -7, 16}};
@@ -102,7 +107,7 @@ std::string team_yaml(int n, const std::string& mode, bool closed) {
     const std::string sensors = i == 0 ? "true" : "false";
     y += "  - {name: uav" + std::to_string(i + 1) + ", initial_position: [" + std::to_string(o[0]) + ", " +
          std::to_string(o[1]) + ", " + std::to_string(o[2]) + "], sees_lead: " + sensors + ", altimeter: " + sensors +
-         ", range: " + sensors + ", camera: {fx: 64.03, fy: 64.03, cx: 160, cy: 160, width: 320, height: 320}}\n";
+         ", range: " + sensors + ", camera: " + (i % 2 == 0 ? kSquare : kWide) + "}\n";
     control += "    - {name: uav" + std::to_string(i + 1) + ", initial_yaw: 0, lambda_d: [" + std::to_string(o[0]) + ", " +
                std::to_string(o[1]) + ", " + std::to_string(o[2]) + "]}\n";
   }
