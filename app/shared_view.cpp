@@ -32,9 +32,9 @@ std::vector<std::pair<int, int>> pairs_sharing_view(const slam::Estimator& est, 
       if (!sees[a] || !sees[b]) continue;
       double overlap = 1;
       if (fp[a] && fp[b]) {
+        const Eigen::AlignedBox2d both = fp[a]->intersection(*fp[b]);
         const double smaller = std::min(fp[a]->volume(), fp[b]->volume());
-        overlap = smaller > 0 ? fp[a]->intersection(*fp[b]).volume() / smaller : 0;
-        if (fp[a]->intersection(*fp[b]).isEmpty()) overlap = 0;
+        overlap = both.isEmpty() || !(smaller > 0) ? 0 : both.volume() / smaller;
       }
       if (overlap > 0) shared.emplace_back(-overlap, a, b);
     }
