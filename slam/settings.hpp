@@ -106,7 +106,7 @@ struct GatingSettings {
 
 struct MapSettings {
   // The filter's map holds at most max_landmarks; 0: max_landmarks_per_camera for each camera in
-  // the filter, so that the cap grows with the team (the run's configuration resolves it).
+  // the filter, so that the cap grows with the team (a run's configuration prints it resolved).
   int max_landmarks = 0;
   int max_landmarks_per_camera = 75;
   int target_per_camera = 25;  // new landmarks while a camera sees fewer
