@@ -46,7 +46,6 @@ int slam_command(const SlamOptions& o, const std::string& variant) {
   apply_step_limit(o.limit, replay.scenario);
   const datasets::Dataset& ds = replay.dataset;
   const RunConfig& scn = replay.scenario;
-  const fs::path& scn_path = replay.scenario_path;
   if (!o.no_plots && !eval::gnuplot_available())
     throw UsageError("gnuplot with the pngcairo terminal was not found; install it or pass --no-plots");
 

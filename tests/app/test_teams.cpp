@@ -142,7 +142,9 @@ TEST_P(TeamRuns, RunToTheEndWithABoundedEstimate) {
     EXPECT_TRUE(std::isfinite(a.rms_error));
     EXPECT_LT(a.rms_error, 3.0);
   }
-  if (rendered) EXPECT_EQ(rec.frontend.frames, static_cast<long>(c.uavs) * cfg.num_steps());
+  if (rendered) {
+    EXPECT_EQ(rec.frontend.frames, static_cast<long>(c.uavs) * cfg.num_steps());
+  }
   EXPECT_GT(m.landmarks.initialised, 10);
 }
 
