@@ -394,8 +394,9 @@ void build_lead_path(const Ctx& ctx, Scenario& s, const Provenance& prov) {
   LeadTrajectorySpec& tr = s.lead.trajectory;
   if (!tr.spline()) {
     // Given, but for another type (the resolved settings print them empty).
-    for (const char* key : {"waypoints", "file"})
-      if ((key[0] == 'w' ? !tr.waypoints.rows.empty() : !tr.file.empty()))
+    for (const auto& [key, given] : {std::pair{"waypoints", !tr.waypoints.rows.empty()},
+                                     std::pair{"file", !tr.file.empty()}})
+      if (given)
         ctx.fail(key_loc(prov, std::string("lead.trajectory.") + key),
                  fmt::format("is used by type {}; this trajectory's type is {}", key, tr.type));
     return;

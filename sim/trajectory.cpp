@@ -68,6 +68,11 @@ SplinePath::SplinePath(const std::vector<TrajectorySample>& samples, SplineEnds 
   }
 }
 
+std::size_t SplinePath::segment(double t) const {
+  const auto after = std::upper_bound(t_.begin(), t_.end(), t) - t_.begin();
+  return std::min(static_cast<std::size_t>(std::max<std::ptrdiff_t>(after - 1, 0)), a_.size() - 1);
+}
+
 KinematicState SplinePath::at(double t) const {
   KinematicState k;
   // Before the first sample and after the last the path holds still; at either sample itself it
@@ -76,8 +81,7 @@ KinematicState SplinePath::at(double t) const {
     k.position = t < t_.front() ? samples_.front().position : samples_.back().position;
     return k;
   }
-  const auto seg = std::upper_bound(t_.begin(), t_.end(), t) - t_.begin() - 1;
-  const std::size_t i = std::min(static_cast<std::size_t>(seg), a_.size() - 1);
+  const std::size_t i = segment(t);
   const double s = t - t_[i];
   k.position = a_[i] + s * (b_[i] + s * (c_[i] + s * d_[i]));
   k.velocity = b_[i] + s * (2 * c_[i] + 3 * s * d_[i]);
@@ -90,7 +94,7 @@ std::optional<Eigen::Quaterniond> SplinePath::orientation(double t) const {
   if (!samples_.front().orientation) return std::nullopt;
   if (t <= t_.front()) return samples_.front().orientation;
   if (t >= t_.back()) return samples_.back().orientation;
-  const std::size_t i = static_cast<std::size_t>(std::upper_bound(t_.begin(), t_.end(), t) - t_.begin()) - 1;
+  const std::size_t i = segment(t);
   const double f = (t - t_[i]) / (t_[i + 1] - t_[i]);
   return samples_[i].orientation->slerp(f, *samples_[i + 1].orientation);
 }

@@ -51,14 +51,15 @@ class SplinePath {
  public:
   SplinePath(const std::vector<TrajectorySample>& samples, SplineEnds ends);
   KinematicState at(double t) const;
-  double t_begin() const { return t_.front(); }
-  double t_end() const { return t_.back(); }
   const std::vector<TrajectorySample>& samples() const { return samples_; }
   // The samples' orientation at t (spherical interpolation between samples), if they have one.
   std::optional<Eigen::Quaterniond> orientation(double t) const;
 
  private:
   std::vector<TrajectorySample> samples_;
+  // The segment [t_i, t_i+1] holding t, for t within the samples' times.
+  std::size_t segment(double t) const;
+
   std::vector<double> t_;
   // Per segment i: p(t) = a + b s + c s^2 + d s^3 with s = t - t_i.
   std::vector<Eigen::Vector3d> a_, b_, c_, d_;

@@ -129,10 +129,6 @@ KinematicState OpenLoopTruth::uav(int j, double t) const {
 KinematicState OpenLoopTruth::formation_offset(int j, double t) const {
   const Eigen::Vector3d o = scn_.uavs[j].initial_position - scn_.lead.initial_position;
   KinematicState k;
-  if (scn_.lead.formation_frame == FormationFrame::World) {
-    k.position = o;
-    return k;
-  }
   const Turn turn = curve_turn(scn_.lead.trajectory, t);
   const Eigen::Vector2d r = Eigen::Rotation2Dd(turn.heading - heading0_) * o.head<2>();
   const Eigen::Vector2d Sr(-r.y(), r.x());

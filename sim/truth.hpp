@@ -64,7 +64,7 @@ class OpenLoopTruth : public Truth {
  private:
   // Agent a (0: lead, 1 + j: UAV j): the curve shifted to start at `start`, plus its deviation.
   KinematicState agent(std::size_t a, const Eigen::Vector3d& start, double t) const;
-  // UAV j's offset from the lead at t and its derivatives (constant in the world frame).
+  // UAV j's offset from the lead at t in the heading frame, and its derivatives.
   KinematicState formation_offset(int j, double t) const;
 
   Eigen::Vector3d origin_;  // the curve's value at t = 0
