@@ -78,7 +78,7 @@ void resolve_estimator(RunConfig& cfg, const Provenance& prov) {
             "its position from the estimator");
   if (e.map.max_landmarks == 0) {
     const int cameras = static_cast<int>(cfg.filter_uavs().size());
-    e.map.max_landmarks = e.map.max_landmarks_per_camera * cameras;
+    e.map.max_landmarks = e.map.landmark_cap(cameras);
     // The covariance grows as (6 max_landmarks)^2 doubles: the same bound as an explicit cap's.
     if (e.map.max_landmarks > 2000)
       fail_at(prov, cfg, prov.find("estimator", "map.max_landmarks_per_camera"),

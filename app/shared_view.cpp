@@ -11,7 +11,7 @@ std::optional<Eigen::AlignedBox2d> ground_footprint(const slam::Estimator& est, 
   const double z = est.lead_position().z();
   const double w = rig.model.width(), h = rig.model.height();
   Eigen::AlignedBox2d box;
-  for (const Eigen::Vector2d uv : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(w, h),
+  for (const Eigen::Vector2d& uv : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(w, h),
                                    Eigen::Vector2d(0, h)}) {
     const Eigen::Vector3d d = rig.R_CW.transpose() * rig.model.bearing(uv);
     const double s = (z - p.z()) / d.z();

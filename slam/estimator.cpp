@@ -114,9 +114,7 @@ SensorUpdateResult Estimator::update_sensors(const SensorBatch& b) {
 }
 
 bool Estimator::make_room() {
-  // 0: the cap grows with the team (MapSettings).
-  const int cap = cfg_.map.max_landmarks > 0 ? cfg_.map.max_landmarks : cfg_.map.max_landmarks_per_camera * num_cameras();
-  if (num_landmarks() < cap) return true;
+  if (num_landmarks() < cfg_.map.landmark_cap(num_cameras())) return true;
   // Oldest landmark not expected in any camera this step: it has left the view.
   for (const auto& lm : s_.landmarks()) {
     auto it = tracks_.find(lm.id);

@@ -110,6 +110,10 @@ struct MapSettings {
   int max_landmarks = 0;
   int max_landmarks_per_camera = 75;
   int target_per_camera = 25;  // new landmarks while a camera sees fewer
+  // The cap for a filter of `cameras` cameras.
+  int landmark_cap(int cameras) const {
+    return max_landmarks > 0 ? max_landmarks : max_landmarks_per_camera * cameras;
+  }
   int max_misses = 5;          // consecutive predicted-visible frames without an accepted match
   double image_margin_px = 10.0;
 
