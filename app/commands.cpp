@@ -46,6 +46,7 @@ int run_cli(int argc, char** argv) {
       add_baseline(cli),
       add_check(cli),
       add_export(cli),
+      add_calibrate_frontend(cli),
   };
 
   // A first word that is neither an option nor a command: say so and list the commands.

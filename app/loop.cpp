@@ -83,6 +83,12 @@ eval::RunRecord make_record(const RunConfig& cfg, const std::vector<int>& cam_ua
   rec.agent_names.push_back("lead");
   for (int u : cam_uav) rec.agent_names.push_back(cfg.uavs[u].name);
   for (const auto& p : cfg.phases) rec.phases.push_back({p.name, p.t_start, p.t_end, sim::to_string(p.config)});
+  const auto& q = cfg.estimator.process_noise;
+  const double common = q.accel_sigma_common;
+  rec.assumed.accel_sigma.push_back(std::hypot(common, q.accel_sigma_lead));
+  for (std::size_t j = 0; j < cam_uav.size(); ++j) rec.assumed.accel_sigma.push_back(std::hypot(common, q.accel_sigma_uav));
+  rec.assumed.pixel_sigma = cfg.estimator.measurement_noise.pixel_sigma;
+  if (cfg.measurements != sim::MeasurementMode::Rendered) rec.assumed.truth_pixel_sigma = cfg.noise.pixel_sigma;
   for (int u : cam_uav) rec.outliers.push_back({cfg.uavs[u].name});
   if (!cfg.single_uav()) rec.outliers.push_back({"cooperative"});
   return rec;

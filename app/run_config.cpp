@@ -7,7 +7,9 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "app/derived_noise.hpp"
 #include "eval/atomic_file.hpp"
+#include "sim/assets.hpp"
 #include "sim/settings_yaml.hpp"
 #include "sim/yaml_input.hpp"
 
@@ -95,6 +97,32 @@ void resolve_estimator(RunConfig& cfg, const Provenance& prov) {
   }
 }
 
+// The estimator's noise keys left `auto` (app/derived_noise.hpp). A rendered run reads the
+// frontend noise model only when it needs it, and a missing or malformed one is bad input at
+// frontend.noise_model.
+void derive_noise(RunConfig& cfg, const Provenance& prov) {
+  derive_process_noise(cfg);
+  const auto& r = cfg.estimator.measurement_noise;
+  vision::FrontendNoiseModel model;
+  std::string path;
+  if (cfg.measurements == sim::MeasurementMode::Rendered && (r.pixel_sigma.automatic || r.pixel_offset_sigma.automatic)) {
+    const sim::Loc* key = prov.find("frontend", "noise_model");
+    try {
+      path = sim::resolve_asset(cfg.frontend.noise_model, cfg.source_path, "frontend noise model");
+      model = read_noise_model(path);
+    } catch (const sim::ScenarioError& e) {
+      fail_at(prov, cfg, key, fmt::format("frontend.noise_model: {}", e.what()));
+    } catch (const std::runtime_error& e) {
+      fail_at(prov, cfg, key, fmt::format("frontend.noise_model: {}", e.what()));
+    }
+  }
+  try {
+    derive_pixel_noise(cfg, model, path);
+  } catch (const std::invalid_argument& e) {
+    fail_at(prov, cfg, prov.find("frontend", "detector"), e.what());
+  }
+}
+
 // Whether some camera in the filter (or the lead, for the GPS) carries the sensor.
 bool carried(const RunConfig& cfg, sim::Sensor s) {
   if (s == sim::Sensor::Landmarks) return true;
@@ -156,6 +184,7 @@ RunConfig compose(const sim::Scenario& scenario) {
   for (const auto& layer : scenario.settings_layers) read_layer(*layer, cfg, prov);
   resolve_estimator(cfg, prov);
   check_phase_sensors(cfg);
+  derive_noise(cfg, prov);
   return cfg;
 }
 

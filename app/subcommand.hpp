@@ -33,6 +33,7 @@ Subcommand add_score_matches(CLI::App& parent);  // app/cmd_score_matches.cpp
 Subcommand add_baseline(CLI::App& parent);       // app/cmd_baseline.cpp
 Subcommand add_check(CLI::App& parent);          // app/cmd_check.cpp
 Subcommand add_export(CLI::App& parent);         // app/cmd_export.cpp
+Subcommand add_calibrate_frontend(CLI::App& parent);  // app/cmd_calibrate_frontend.cpp
 // Further subcommands declare their add_<name>() here.
 
 }  // namespace wingman::app

@@ -81,7 +81,9 @@ Prepared prepare(int n_landmarks) {
   Prepared out;
   out.cam_truth = {Vector3d(-1.5, 0, 15), Vector3d(1.5, 0, 17)};
   slam::EstimatorSettings cfg;
-  cfg.process_noise = {0.1, 0.5, 0.0};  // white, per agent
+  cfg.process_noise.accel_sigma_lead = 0.1;  // white, per agent
+  cfg.process_noise.accel_sigma_uav = 0.5;
+  cfg.process_noise.accel_sigma_common = 0.0;
   cfg.measurement_noise.orientation_sigma = 0;
   cfg.gating.ransac_inlier_px = 4;
   cfg.map.max_landmarks = n_landmarks;

@@ -209,6 +209,7 @@ Metrics compute_metrics(const RunRecord& run) {
   }
   m.landmarks.initialised = static_cast<long>(run.landmarks.size());
   m.formation = compute_formation_metrics(run);
+  m.consistency = diagnose_consistency(run, m);
   return m;
 }
 

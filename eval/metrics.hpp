@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "eval/formation.hpp"
+#include "eval/consistency.hpp"
 #include "eval/run_record.hpp"
 
 namespace wingman::eval {
@@ -95,6 +96,7 @@ struct Metrics {
   LandmarkCounts landmarks;
   FormationMetrics formation;  // closed loop only (formation.hpp)
   FrontendMetrics frontend;    // rendered mode only
+  Consistency consistency;     // NEES blocks outside their band, and why (consistency.hpp)
 };
 
 // Throws std::invalid_argument if a step's agent count differs from agent_names or a step

@@ -144,6 +144,13 @@ struct PhaseInfo {
   std::string config;  // "1", "2", "3", "integrated"
 };
 
+// The noise the filter assumed, beside its input, for the consistency diagnosis.
+struct AssumedNoise {
+  std::vector<double> accel_sigma;  // per agent (agent_names order): sqrt(common^2 + own^2), m/s^2
+  double pixel_sigma = kNaN;        // px per axis
+  double truth_pixel_sigma = kNaN;  // synthetic: the truth's noise.pixel_sigma; NaN when rendered
+};
+
 struct RunRecord {
   std::string scenario_path, scenario_name, variant;
   std::string estimator_mode;  // "multi" or "single"
@@ -155,6 +162,7 @@ struct RunRecord {
   std::vector<LandmarkRecord> landmarks;
   std::vector<OutlierCounts> outliers;
   FrontendRecord frontend;
+  AssumedNoise assumed;
   double wall_time_s = 0;
   // The filter's numerical breakdown (estimator.on_numerical_failure: record): the steps end
   // before it; empty message when none.

@@ -148,6 +148,21 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
                {"per_agent", per_agent},
                {"per_step", per_step}};
 
+  json findings = json::array();
+  for (const ConsistencyFinding& f : m.consistency.findings)
+    findings.push_back({{"phase", f.phase},
+                        {"agent", f.agent},
+                        {"block", f.block},
+                        {"nees", num(f.nees)},
+                        {"band", {num(f.band_lo), num(f.band_hi)}},
+                        {"independent_looks", num(f.independent_looks)},
+                        {"verdict", f.verdict},
+                        {"assumed_accel_sigma", num(f.assumed_accel_sigma)},
+                        {"truth_accel", num(f.truth_accel)},
+                        {"assumed_pixel_sigma", num(f.assumed_pixel_sigma)},
+                        {"pixel_error", num(f.pixel_error)}});
+  j["consistency"] = {{"blocks_checked", m.consistency.blocks_checked}, {"outside_band", findings}};
+
   j["timings_ms"] = {{"predict", stats(m.timings_ms.predict)},
                      {"update", stats(m.timings_ms.update)},
                      {"init", stats(m.timings_ms.init)},
@@ -354,6 +369,39 @@ void write_results(const Metrics& metrics, const RunRecord& run, const fs::path&
     write_correspondences_csv(run, dir / "correspondences.csv");
 }
 
+namespace {
+
+// The blocks of the NEES outside their band, the farthest first, with what the filter assumed.
+template <typename Out>
+void format_consistency(Out& out, const Consistency& c) {
+  if (c.findings.empty()) {
+    if (c.blocks_checked > 0)
+      fmt::format_to(out, "\nConsistency: every position and velocity block of the {} checked inside its band",
+                     c.blocks_checked);
+    return;
+  }
+  std::vector<const ConsistencyFinding*> f;
+  for (const auto& x : c.findings) f.push_back(&x);
+  auto far = [](const ConsistencyFinding* x) { return std::abs(std::log(x->nees / 3.0)); };
+  std::sort(f.begin(), f.end(), [&](auto* a, auto* b) { return far(a) > far(b); });
+  fmt::format_to(out, "\nConsistency: {} of {} blocks (agent x phase x position|velocity) outside their band",
+                 f.size(), c.blocks_checked);
+  const std::size_t shown = std::min<std::size_t>(f.size(), 6);
+  for (std::size_t i = 0; i < shown; ++i) {
+    const ConsistencyFinding& x = *f[i];
+    fmt::format_to(out,
+                   "\n  {} {} in {}: NEES {} (band {}-{} of 3, {} independent looks): {}; assumed acceleration "
+                   "{} m/s^2 against the truth's {} (worst {} s RMS per axis), pixel sigma {} px against {}",
+                   x.agent, x.block, x.phase, cell(x.nees, 0, 3), cell(x.band_lo, 0, 3), cell(x.band_hi, 0, 3),
+                   cell(x.independent_looks, 0, 3), x.verdict, cell(x.assumed_accel_sigma, 0, 3),
+                   cell(x.truth_accel, 0, 3), kAccelerationWindowS, cell(x.assumed_pixel_sigma, 0, 3),
+                   cell(x.pixel_error, 0, 3));
+  }
+  if (f.size() > shown) fmt::format_to(out, "\n  ... {} more in metrics.json (consistency)", f.size() - shown);
+}
+
+}  // namespace
+
 std::string format_summary(const Metrics& m, const RunRecord& run) {
   fmt::memory_buffer b;
   auto out = std::back_inserter(b);
@@ -441,6 +489,7 @@ std::string format_summary(const Metrics& m, const RunRecord& run) {
     fmt::format_to(out, "{} {} {}", p == 0 ? "; per phase:" : ",",
                    phase_name(run, static_cast<int>(p)), cell(m.nees.per_phase_mean[p], 0, 3));
   }
+  format_consistency(out, m.consistency);
   const Timings& t = m.timings_ms;
   fmt::format_to(out,
                  "\nStep time [ms]: mean {} (predict {}, update {}, init {}), median {}, p95 {}, "

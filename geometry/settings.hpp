@@ -6,11 +6,12 @@
 //     v.section("gating", [&](auto& g) { g("probability", gate_probability, in(0, 1, true, true)); });
 //   }
 //
-// and every walker of settings is such a V: the scenario reader (app/settings_yaml.hpp) fills the
+// and every walker of settings is such a V: the scenario reader (sim/settings_yaml.hpp) fills the
 // struct from YAML with file:line:key errors, the printer writes the resolved values, the
 // documentation test compares docs/scenario.md with the defaults. A visitor takes
 //   v(key, double&, Bounds)   v(key, int&, Bounds)   v(key, bool&)   v(key, std::string&)
 //   v(key, Eigen::Vector3d&)  v(key, Eigen::Vector4d&, Bounds)  v(key, SeedSetting&)
+//   v(key, AutoNumber&, Bounds)  (a number or `auto`)
 //   v.choice(key, E&, {{"name", E::Value}, ...})
 //   v.section(key, [&](auto& sub) { ... })
 // Keys are YAML keys; the struct's field names may differ (the code's names stay frame- and
@@ -20,6 +21,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
+#include <string>
 #include <string_view>
 #include <utility>
 
@@ -52,6 +54,33 @@ struct SeedSetting {
   // The seed to draw from in a run of seed `run_seed`.
   std::uint64_t resolve(std::uint64_t run_seed) const { return per_run ? run_seed : value; }
   bool operator==(const SeedSetting&) const = default;
+};
+
+// A number a scenario may leave to the run (`auto`, the default of such keys): the run derives it
+// from what the scenario flies or from the frontend's noise model, and the resolved configuration
+// prints the value with where it came from. A number written in the file is taken as it is.
+struct AutoNumber {
+  double value = 0;
+  bool automatic = true;
+  std::string source;  // where a derived value came from; empty while unresolved
+
+  AutoNumber() = default;
+  // `fallback` is what code that never resolves the setting (a test's settings struct) uses.
+  explicit AutoNumber(double fallback) : value(fallback) {}
+  // A value set in code is the user's: never derived over.
+  AutoNumber& operator=(double v) {
+    value = v;
+    automatic = false;
+    source.clear();
+    return *this;
+  }
+  operator double() const { return value; }  // NOLINT: reads as the number it holds
+  // Sets a derived value (only while automatic: a value the user wrote stays).
+  void derive(double v, std::string why) {
+    if (!automatic) return;
+    value = v;
+    source = std::move(why);
+  }
 };
 
 // The names an enum takes in files, in the order they are listed to a user.

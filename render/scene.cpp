@@ -280,6 +280,15 @@ Mesh objects_mesh(const std::vector<sim::WorldObject>& objects, int material) {
 
 Eigen::Vector3d to_vec(const aiVector3D& v) { return {v.x, v.y, v.z}; }
 
+// Solids (objects, the lead's model) are sampled without anisotropic filtering. Their faces can be
+// seen edge-on, where the texture footprint of a pixel is unbounded, and llvmpipe filters
+// anisotropically by an elliptical weighted average over every texel of the footprint's bounding
+// box at the chosen mipmap level (gallivm's lp_build_sample_aniso): once the footprint outgrows
+// the coarsest level that box is no longer bounded, and with MSAA shading such slivers a single
+// frame took minutes (docs/studies/render-object-cost.md). A solid's faces are small and seen
+// from above; the ground and the flat cue keep world.texture.anisotropy.
+constexpr double kSolidAnisotropy = 1.0;
+
 constexpr double kCueLift = sim::kLeadCueLift;
 
 }  // namespace
@@ -325,7 +334,7 @@ void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, co
         m->GetTexture(aiTextureType_BASE_COLOR, 0, &tex) != AI_SUCCESS)
       continue;
     Material mat;
-    mat.anisotropy = sampling.anisotropy;
+    mat.anisotropy = kSolidAnisotropy;
     mat.trilinear = sampling.trilinear;
     if (const aiTexture* emb = ai->GetEmbeddedTexture(tex.C_Str())) {
       cv::Mat raw;
@@ -436,7 +445,7 @@ Scene build_scene(const sim::WorldDescription& world) {
   if (!objects.empty()) {
     Material detail;
     detail.texture = detail_texture(world.seed);
-    detail.anisotropy = w.texture.anisotropy;
+    detail.anisotropy = kSolidAnisotropy;
     detail.trilinear = ground.trilinear;
     scene.materials.push_back(detail);
     scene.static_meshes.push_back(

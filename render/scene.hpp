@@ -54,7 +54,8 @@ using LeadPose = sim::LeadPose;
 // The lead model from any format assimp reads, scaled to `height`, its up axis made z, its
 // top-centre moved to the origin; with the cue on its roof. Throws std::runtime_error naming the
 // file when it is missing, not a model, or refers to a missing texture. Its materials sample their
-// textures as `sampling` does (anisotropy, trilinear; build_scene passes the ground's).
+// textures as `sampling` does between mipmap levels (build_scene passes the ground's); the cue
+// takes its anisotropy too, the model's own faces none (scene.cpp, kSolidAnisotropy).
 void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, const Material& sampling,
                      Scene& scene);
 

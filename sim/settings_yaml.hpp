@@ -85,6 +85,16 @@ class Reader {
   void operator()(std::string_view key, geometry::SeedSetting& x) {
     if (auto f = get(key)) x = read_seed_setting(ctx_, *f);
   }
+  void operator()(std::string_view key, geometry::AutoNumber& x, geometry::Bounds b = {}) {
+    auto f = get(key);
+    if (!f) return;
+    if (f->node.IsScalar() && f->node.Scalar() == "auto") {
+      x.automatic = true;
+      x.source.clear();
+      return;
+    }
+    x = read_number(ctx_, *f, b);
+  }
   // A key of this map that another reader reads.
   void other(std::string_view) {}
   // A condition on values already read: fails at `key` (or at the map when the key is absent).
@@ -187,6 +197,16 @@ class Emitter {
   void put(int x) { out_ << x; }
   void put(bool x) { out_ << (x ? "true" : "false"); }
   void put(const std::string& x) { out_ << x; }
+  // A derived value prints as the number with its origin as a comment, so that the file reruns
+  // the same; one not yet derived prints as `auto`.
+  void put(const geometry::AutoNumber& a) {
+    if (a.automatic && a.source.empty())
+      out_ << "auto";
+    else if (a.automatic)
+      out_ << number_text(a.value) << YAML::Comment(a.source);
+    else
+      out_ << number_text(a.value);
+  }
   void put(const geometry::SeedSetting& s) {
     if (s.per_run)
       out_ << "per_run";

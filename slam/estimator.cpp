@@ -45,7 +45,7 @@ Estimator::Estimator(std::vector<CameraRig> cameras, const AgentInit& lead,
 
 void Estimator::predict(double dt) {
   const ProcessNoiseSettings& q = cfg_.process_noise;
-  predict_constant_velocity(s_, dt, q.accel_sigma_lead, q.accel_sigma_uav, q.accel_sigma_common);
+  predict_constant_velocity(s_, dt, q.accel_sigma_lead.value, q.accel_sigma_uav.value, q.accel_sigma_common.value);
   for (int j = 0; j < num_cameras(); ++j)
     predict_gimbal_error(s_, j, dt, cams_[j].orientation_sigma, cfg_.measurement_noise.orientation_time_constant);
   predict_common_acceleration(s_, dt, q.common_state_sigma, q.common_state_time_constant);
@@ -58,7 +58,7 @@ std::vector<LandmarkPrediction> Estimator::predictions_in_view(int cam) const {
   for (const auto& lm : s_.landmarks()) {
     auto uv = predict_landmark_pixel(s_, s_.x, lm, cam, rig);
     if (!uv || !rig.model.in_image(*uv, cfg_.map.image_margin_px)) continue;
-    auto m = landmark_measurement(s_, lm, cam, rig, *uv, cfg_.measurement_noise.pixel_sigma);
+    auto m = landmark_measurement(s_, lm, cam, rig, *uv, cfg_.measurement_noise.pixel_sigma.value);
     if (!m) continue;
     out.push_back({lm.id, *uv, innovation_covariance(s_, *m)});
   }
@@ -76,7 +76,7 @@ VisualUpdateResult Estimator::update_visual(
     const std::vector<std::pair<int, Eigen::Vector2d>>& lead_pixels) {
   std::vector<Measurement> lead;
   for (const auto& [cam, uv] : lead_pixels)
-    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.measurement_noise.pixel_sigma))
+    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.measurement_noise.pixel_sigma.value))
       lead.push_back(std::move(*m));
   for (const auto& m : lead) check_measurement(m, fmt::format("the lead's pixel in camera {}", m.camera));
   for (const auto& c : candidates)
@@ -84,7 +84,7 @@ VisualUpdateResult Estimator::update_visual(
       throw NumericalFailure(fmt::format("numerical failure: the pixel of landmark {} in camera {} is not finite",
                                          c.id, c.cam));
   VisualUpdateResult r = update_with_correspondences(s_, cams_, candidates, cfg_.gating,
-                                                     cfg_.measurement_noise.pixel_sigma, rng_, lead);
+                                                     cfg_.measurement_noise.pixel_sigma.value, rng_, lead);
   for (size_t i = 0; i < candidates.size(); ++i)
     if (r.accepted[i]) tracks_[candidates[i].id].matched = true;
   check_state(s_, fmt::format("the visual update ({} landmark pixels, {} lead pixels)", candidates.size(),

@@ -142,15 +142,15 @@ InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& c
     deps.push_back({g, -Jza * pixel_gimbal_jacobian(rig_a.model, s.x(g), ray(rig_a, uv_a))});
   if (const int g = s.gimbal(cam_b); g >= 0)
     deps.push_back({g, -Jzb * pixel_gimbal_jacobian(rig_b.model, s.x(g), ray(rig_b, uv_b))});
-  const Eigen::Matrix3d pixel_cov = Jza * pixel_covariance(rig_a, pC_a, noise.pixel_sigma) * Jza.transpose() +
-                                    Jzb * pixel_covariance(rig_b, pC_b, noise.pixel_sigma) * Jzb.transpose();
+  const Eigen::Matrix3d pixel_cov = Jza * pixel_covariance(rig_a, pC_a, noise.pixel_sigma.value) * Jza.transpose() +
+                                    Jzb * pixel_covariance(rig_b, pC_b, noise.pixel_sigma.value) * Jzb.transpose();
   const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
-  if (!(noise.pixel_offset_sigma > 0)) return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
+  if (!(noise.pixel_offset_sigma.value > 0)) return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
 
   // With pixel offsets: the point was triangulated from uv_b - o_b with o_b ~ N(0, sigma^2 I), so
   // d point / d o_b = -Jzb; the other cameras' offsets start independent of everything.
-  const double var = noise.pixel_offset_sigma * noise.pixel_offset_sigma;
-  auto w = append_pixel_offsets(s, t->point, cross, cov, noise.pixel_offset_sigma);
+  const double var = noise.pixel_offset_sigma.value * noise.pixel_offset_sigma.value;
+  auto w = append_pixel_offsets(s, t->point, cross, cov, noise.pixel_offset_sigma.value);
   LandmarkSlot probe;  // where camera b's offset sits among the new parameters
   probe.anchor_cam = cam_a;
   probe.extra = static_cast<int>(w.value.size()) - 3;
@@ -194,13 +194,13 @@ InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& c
   const Eigen::Vector3d ray_C(xn.x(), xn.y(), 1.0);
   if (const int g = s.gimbal(cam); g >= 0)
     deps.push_back({g, -Juv * pixel_gimbal_jacobian(rig.model, s.x(g), ray_C)});
-  Eigen::Matrix<double, 6, 6> pixel_cov = Juv * pixel_covariance(rig, ray_C, noise.pixel_sigma) * Juv.transpose();
+  Eigen::Matrix<double, 6, 6> pixel_cov = Juv * pixel_covariance(rig, ray_C, noise.pixel_sigma.value) * Juv.transpose();
   pixel_cov(5, 5) = cfg.inverse_depth_sigma * cfg.inverse_depth_sigma;  // the depth prior, independent of the state
   const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
-  if (!(noise.pixel_offset_sigma > 0) || s.num_cameras() < 2)
+  if (!(noise.pixel_offset_sigma.value > 0) || s.num_cameras() < 2)
     return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
   // The other cameras' offsets start at 0, independent of everything (this pixel has none).
-  const auto w = append_pixel_offsets(s, y, cross, cov, noise.pixel_offset_sigma);
+  const auto w = append_pixel_offsets(s, y, cross, cov, noise.pixel_offset_sigma.value);
   return {s.add_landmark(LandmarkKind::InverseDepth, w.value, w.cross, w.cov, cam), ""};
 }
 
@@ -227,7 +227,7 @@ InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, cons
       rho_lin = 1.0 / d;
   const double rho_prior = s.x(rho);
   s.x(rho) = rho_lin;
-  std::optional<Measurement> m = landmark_measurement(s, *lm, cam_b, commanded_b, uv_b, noise.pixel_sigma);
+  std::optional<Measurement> m = landmark_measurement(s, *lm, cam_b, commanded_b, uv_b, noise.pixel_sigma.value);
   s.x(rho) = rho_prior;
   if (m)
     for (const auto& b : m->blocks)

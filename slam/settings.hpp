@@ -19,11 +19,14 @@ using geometry::in;
 enum class EstimatorMode { MultiUav, SingleUav };
 const char* to_string(EstimatorMode m);
 
-// White accelerations of the constant-velocity model (eq. 34), m/s^2.
+// White accelerations of the constant-velocity model (eq. 34), m/s^2. `auto` (the default): from
+// what the scenario flies (app/derived_noise.hpp): the common part from the lead's accelerations,
+// each agent's own from its departure from them (a formation that turns with the lead, the noise
+// of noise.motion, the closed loop's disturbance).
 struct ProcessNoiseSettings {
-  double accel_sigma_lead = 0.05, accel_sigma_uav = 0.05;
+  geometry::AutoNumber accel_sigma_lead{0.05}, accel_sigma_uav{0.05};
   // An acceleration every agent shares (formation flight), on top of each agent's own.
-  double accel_sigma_common = 0.3;
+  geometry::AutoNumber accel_sigma_common{0.3};
   // Both > 0: the shared acceleration is a state, Gauss-Markov (Singer) with this std (m/s^2)
   // and correlation time (s), instead of white.
   double common_state_sigma = 0, common_state_time_constant = 0;
@@ -43,10 +46,14 @@ struct ProcessNoiseSettings {
 
 // The noise the filter assumes (R); it may differ from the truth's (the scenario's noise:).
 struct MeasurementNoiseSettings {
-  double pixel_sigma = 3.0;  // px, per axis
+  // px, per axis. `auto` (the default): synthetic runs take the truth's noise.pixel_sigma (the
+  // sensor's specification), rendered runs the frontend noise model's figure for the detector.
+  geometry::AutoNumber pixel_sigma{3.0};
   // > 0: every landmark carries each other camera's constant pixel offset from the camera that
-  // initialised it, prior sigma this (px per axis); 0: pixel errors are white.
-  double pixel_offset_sigma = 0.0;
+  // initialised it, prior sigma this (px per axis); 0: pixel errors are white. `auto`: synthetic
+  // runs take sqrt(2) noise.pixel_bias_sigma (the difference of two cameras' offsets), rendered
+  // runs the frontend noise model's.
+  geometry::AutoNumber pixel_offset_sigma{0.0};
   double gps_sigma = 1.5, altimeter_sigma = 0.5, range_sigma = 0.5;  // m
   // Gimbal pointing error about the camera's x and y axes (rad). 0.028 is the rms of the paper
   // scenes' truth error 0.04 sin(0.3 t); 0 trusts R_CW exactly.
@@ -59,11 +66,13 @@ struct MeasurementNoiseSettings {
   template <class V>
   void visit(V& v) {
     // The same ranges as the truth's noise (sim/scenario.hpp), for the same reason.
-    v("pixel_sigma", pixel_sigma, in(0, 1000));
+    // An assumed sigma of 0 would make the innovation covariance singular: the filter's sigmas
+    // are > 0 (the truth's may be 0, a perfect sensor).
+    v("pixel_sigma", pixel_sigma, in(0, 1000, true));
     v("pixel_offset_sigma", pixel_offset_sigma, in(0, 1000));
-    v("gps_sigma", gps_sigma, in(0, 1e4));
-    v("altimeter_sigma", altimeter_sigma, in(0, 1e4));
-    v("range_sigma", range_sigma, in(0, 1e4));
+    v("gps_sigma", gps_sigma, in(0, 1e4, true));
+    v("altimeter_sigma", altimeter_sigma, in(0, 1e4, true));
+    v("range_sigma", range_sigma, in(0, 1e4, true));
     v("orientation_sigma", orientation_sigma, in(0, 1));
     v("orientation_time_constant", orientation_time_constant, ge(0));
   }

@@ -20,10 +20,14 @@ struct FrontendSettings {
   // what is found stay the frontend's, so a run separates the estimator's error from the pixel
   // noise of detection (docs/pipeline_rendered.md).
   bool oracle_pixels = false;
+  // The frontend noise model (vision/noise_model.hpp) a rendered run takes the estimator's pixel
+  // noise from when it leaves it `auto`: next to the scenario, then in assets/.
+  std::string noise_model = "frontend/noise_model.yaml";
 
   template <class V>
   void visit(V& v) {
     features.visit(v);
+    v("noise_model", noise_model);
     v.section("tracking", [&](auto& t) { tracking.visit(t); });
     v.section("cross_matching", [&](auto& c) { cross_matching.visit(c); });
     v.section("active_search", [&](auto& a) { active_search.visit(a); });
