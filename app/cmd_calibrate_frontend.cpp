@@ -30,6 +30,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// px: what the replay's filter assumes where the scenario would take its pixel noise from a model.
+constexpr double kCalibrationPixelSigma = 1.0, kCalibrationPixelOffsetSigma = 0.75;
+
 struct CalibrateOptions {
   std::string dataset, out, variant;
   std::vector<std::string> detectors{"orb", "gftt_orb"};
@@ -54,12 +57,21 @@ int calibrate_command(const CalibrateOptions& o) {
   }
   Replay replay = load_replay(o.dataset, o.variant, o.quiet);
   apply_step_limit(o.limit, replay.scenario);
+  // The replay's gate must not depend on the model being measured: where the scenario takes its
+  // pixel noise from a model, the replay assumes a generous fixed one instead.
+  auto& r = replay.scenario.estimator.measurement_noise;
+  if (r.pixel_sigma.automatic) r.pixel_sigma = kCalibrationPixelSigma;
+  if (r.pixel_offset_sigma.automatic) r.pixel_offset_sigma = kCalibrationPixelOffsetSigma;
   vision::FrontendNoiseModel model;
-  model.made_by = fmt::format("wingman calibrate-frontend {} --detectors {}{}", o.dataset,
-                              fmt::join(o.detectors, ","),
-                              o.limit.duration ? fmt::format(" --duration {}", *o.limit.duration)
-                              : o.limit.frames ? fmt::format(" --frames {}", *o.limit.frames)
-                                               : std::string());
+  model.made_by = fmt::format(
+      "wingman calibrate-frontend DATASET --detectors {}{}; DATASET: wingman render of {} (seed {}, {} s); "
+      "the replay's filter assumed pixel_sigma {} px, pixel_offset_sigma {} px",
+      fmt::join(o.detectors, ","),
+      o.limit.duration ? fmt::format(" --duration {}", *o.limit.duration)
+      : o.limit.frames ? fmt::format(" --frames {}", *o.limit.frames)
+                       : std::string(),
+      replay.scenario.name, replay.scenario.seed, replay.scenario.duration, double(r.pixel_sigma),
+      double(r.pixel_offset_sigma));
   for (vision::DetectorKind kind : kinds) {
     vision::FeatureSettings features = replay.scenario.frontend.features;
     features.kind = kind;

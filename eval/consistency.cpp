@@ -38,15 +38,25 @@ std::vector<double> block_series(const RunRecord& run, int p, std::size_t a, boo
   return out;
 }
 
-// Independent looks a series of n steps is worth: n over its integrated autocorrelation, the
-// autocorrelation summed up to its first non-positive lag (a single run's estimate is noisy).
+// Independent looks a series of n steps is worth: n over its integrated autocorrelation (about
+// the series' own mean), summed up to its first non-positive lag (a single run's estimate is
+// noisy beyond it).
 double independent_looks(const std::vector<double>& x) {
   const std::size_t n = x.size();
   if (n < 4) return static_cast<double>(n);
-  std::vector<double> acf = nees_autocorrelation({x}, 0, n, n / 4);
-  std::size_t cut = 1;
-  while (cut < acf.size() && acf[cut] > 0) ++cut;
-  acf.resize(cut);
+  double mean = 0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(n);
+  double c0 = 0;
+  for (double v : x) c0 += (v - mean) * (v - mean);
+  if (!(c0 > 0)) return static_cast<double>(n);
+  std::vector<double> acf = {1.0};
+  for (std::size_t h = 1; h <= n / 4; ++h) {
+    double c = 0;
+    for (std::size_t i = h; i < n; ++i) c += (x[i] - mean) * (x[i - h] - mean);
+    if (!(c > 0)) break;
+    acf.push_back(c / c0);
+  }
   return std::clamp(static_cast<double>(n) / integrated_correlation_steps(acf), 1.0, static_cast<double>(n));
 }
 

@@ -51,9 +51,11 @@ struct TextureSpec {
   double detail_min = 0.02;  // m, finest and coarsest detail of the procedural texture
   double detail_max = 0.2;
   int size = 2048;           // px of the procedural texture (one tile, detail_min per texel)
-  // Max anisotropic filtering; 1 disables it. A nadir camera with the paper's 136 deg field of
-  // view sees the ground at most 68 deg off-axis, an anisotropy of about 2.7: 4 is enough.
-  double anisotropy = 4;
+  // Max anisotropic filtering of the ground and the cue (solids never take it); 1 disables it.
+  // A nadir camera of 75 deg sees the ground at most 37 deg off-axis, a footprint 1.25 times
+  // longer than wide: 1 (the default) loses nothing; the paper's 136 deg camera reaches 2.7,
+  // where 4 sharpens the image's edges at twice the rendering time (docs/rendering.md).
+  double anisotropy = 1;
   // Minification between mipmap levels: trilinear blends the two nearest levels; bilinear samples
   // the nearest one only (GL_LINEAR_MIPMAP_NEAREST), a quarter less rendering time on llvmpipe,
   // with a visible step in sharpness where the level changes (docs/rendering.md, Speed).
@@ -131,7 +133,7 @@ struct LightSpec {
 };
 
 struct ImageEffectsSpec {
-  int msaa = 4;                   // samples per pixel (1 = off)
+  int msaa = 1;                   // samples per pixel (1 = off; docs/rendering.md, image quality)
   double noise_sigma = 0;         // grey levels (0-255) of Gaussian sensor noise
   double blur_sigma = 0;          // px of Gaussian blur
   double exposure_gain = 1;       // multiplies the image

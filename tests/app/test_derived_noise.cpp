@@ -9,6 +9,7 @@
 
 #include "app/app_test_support.hpp"
 #include "app/derived_noise.hpp"
+#include "gl_required.hpp"
 #include "app/run_config.hpp"
 #include "sim/assets.hpp"
 #include "sim/settings_yaml.hpp"
@@ -16,6 +17,7 @@
 namespace wingman::app {
 namespace {
 
+namespace fs = std::filesystem;
 using test::TempDir;
 using test::write_file;
 
@@ -133,6 +135,62 @@ TEST(DerivedNoise, MalformedNoiseModelsAreRefusedNamingFileLineAndKey) {
   e = error_of("measurements: rendered\nfrontend: {noise_model: /nonexistent/model.yaml}\n");
   EXPECT_NE(e.find("scn.yaml:2:"), std::string::npos) << e;
   EXPECT_NE(e.find("not found"), std::string::npos) << e;
+}
+
+TEST(DerivedNoise, CommandLineRefusesABadModelAndAZeroSigmaWithExit2AndWritesNothing) {
+  TempDir tmp;
+  write_file(tmp.path() / "model.yaml", "detectors:\n  orb: {pixel_sigma: 1, pixel_offset_sigma: 1, observations: 3,\n    colour: red}\n");
+  write_file(tmp.path() / "bad_model.yaml", "measurements: rendered\nfrontend: {noise_model: model.yaml}\n");
+  auto r = test::run_wingman({"run", (tmp.path() / "bad_model.yaml").string(), "--out", (tmp.path() / "out").string()},
+                             tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("model.yaml:3:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("detectors.orb.colour"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
+  write_file(tmp.path() / "zero.yaml", "estimator:\n  measurement_noise: {gps_sigma: -0.0}\n");
+  r = test::run_wingman({"run", (tmp.path() / "zero.yaml").string(), "--out", (tmp.path() / "out").string()}, tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("zero.yaml:2:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("estimator.measurement_noise.gps_sigma"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
+  // calibrate-frontend refuses an output that exists, before any work.
+  write_file(tmp.path() / "exists.yaml", "x");
+  r = test::run_wingman({"calibrate-frontend", tmp.path().string(), "--out", (tmp.path() / "exists.yaml").string()},
+                        tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(test::read_file(tmp.path() / "exists.yaml"), "x");
+}
+
+// The command end to end on a small rendered dataset: a model the loader reads back, with
+// figures of the size the frontend's pixels have.
+TEST(DerivedNoise, CalibrateFrontendWritesAModelRenderedRunsRead) {
+  TempDir tmp;
+  const std::string cam = "camera: {fx: 300, fy: 300, cx: 319.5, cy: 239.5, width: 640, height: 480}";
+  write_file(tmp.path() / "cal.yaml", "name: cal\nduration: 6\nmeasurements: rendered\nuavs:\n"
+                                      "  - {name: uav1, initial_position: [-1.5, 0, 15], " + cam + "}\n"
+                                      "  - {name: uav2, initial_position: [1.5, 0, 17], " + cam + "}\n");
+  auto r = test::run_wingman({"render", (tmp.path() / "cal.yaml").string(), "--out", (tmp.path() / "ds").string(), "-q"},
+                             tmp.path());
+  if (r.exit_code != 0 && r.output.find("GL") != std::string::npos) WINGMAN_NO_GL_CONTEXT(r.output);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_wingman({"calibrate-frontend", (tmp.path() / "ds").string(), "--out", (tmp.path() / "m.yaml").string(),
+                         "--detectors", "orb", "-q"},
+                        tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const vision::FrontendNoiseModel m = read_noise_model((tmp.path() / "m.yaml").string());
+  ASSERT_TRUE(m.orb.calibrated());
+  EXPECT_FALSE(m.gftt_orb.calibrated());
+  EXPECT_GT(m.orb.tracks, 20);
+  EXPECT_GT(m.orb.pixel_sigma, 0.05);
+  EXPECT_LT(m.orb.pixel_sigma, 1.5);
+  EXPECT_LT(m.orb.median_error_px, 1.5);
+  EXPECT_NE(m.made_by.find("wingman render of cal"), std::string::npos) << m.made_by;
+  // A rendered scenario that names the model takes its figures.
+  const RunConfig c = parse_run_configs("measurements: rendered\nfrontend: {noise_model: " +
+                                            (tmp.path() / "m.yaml").string() + "}\n",
+                                        "scn.yaml")
+                          .front();
+  EXPECT_DOUBLE_EQ(c.estimator.measurement_noise.pixel_sigma, m.orb.pixel_sigma);
 }
 
 TEST(DerivedNoise, TrackNoiseSplitsConstantOffsetsFromWhiteScatter) {

@@ -26,7 +26,8 @@ TEST(World, DefaultsWhenAbsent) {
   const Scenario s = parse_scenarios("name: x\n", "w.yaml").front();
   EXPECT_EQ(s.world.texture.type, TextureSpec::Type::Image);
   EXPECT_EQ(s.world.lead.cue, LeadModelSpec::Cue::Aruco);
-  EXPECT_EQ(s.world.image.msaa, 4);
+  EXPECT_EQ(s.world.image.msaa, 1);
+  EXPECT_EQ(s.world.texture.anisotropy, 1.0);
   EXPECT_EQ(s.world.texture.filter, TextureSpec::Filter::Trilinear);
   EXPECT_NE(s.world.lead.model.find("CesiumMilkTruck"), std::string::npos);
 }
