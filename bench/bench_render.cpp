@@ -64,12 +64,17 @@ void time_frames(benchmark::State& state, render::Renderer& renderer, const rend
   state.SetLabel(renderer.context().description());
 }
 
-void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
-  sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic.yaml").front();
+// The benchmark's arguments: MSAA samples, max anisotropy, trilinear (1) or bilinear (0).
+void apply_quality(const benchmark::State& state, sim::Scenario& scn) {
   scn.world.image.msaa = static_cast<int>(state.range(0));
   scn.world.texture.anisotropy = static_cast<double>(state.range(1));
   scn.world.texture.filter =
       state.range(2) ? sim::TextureSpec::Filter::Trilinear : sim::TextureSpec::Filter::Bilinear;
+}
+
+void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
+  sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic.yaml").front();
+  apply_quality(state, scn);
   const auto ctx = context_or_skip(state, backend);
   if (!ctx) return;
   render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
@@ -183,10 +188,7 @@ const SweepWorld& sweep_world() {
 
 void quality_sweep(benchmark::State& state, render::GlBackend backend) {
   sim::Scenario scn = sweep_world().scn;
-  scn.world.image.msaa = static_cast<int>(state.range(0));
-  scn.world.texture.anisotropy = static_cast<double>(state.range(1));
-  scn.world.texture.filter =
-      state.range(2) ? sim::TextureSpec::Filter::Trilinear : sim::TextureSpec::Filter::Bilinear;
+  apply_quality(state, scn);
   const auto ctx = context_or_skip(state, backend);
   if (!ctx) return;
   render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));

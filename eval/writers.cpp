@@ -149,18 +149,23 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
                {"per_step", per_step}};
 
   json findings = json::array();
-  for (const ConsistencyFinding& f : m.consistency.findings)
-    findings.push_back({{"phase", f.phase},
-                        {"agent", f.agent},
-                        {"block", f.block},
-                        {"nees", num(f.nees)},
-                        {"band", {num(f.band_lo), num(f.band_hi)}},
-                        {"independent_looks", num(f.independent_looks)},
-                        {"verdict", f.verdict},
-                        {"assumed_accel_sigma", num(f.assumed_accel_sigma)},
-                        {"truth_accel", num(f.truth_accel)},
-                        {"assumed_pixel_sigma", num(f.assumed_pixel_sigma)},
-                        {"pixel_error", num(f.pixel_error)}});
+  for (const ConsistencyFinding& f : m.consistency.findings) {
+    json row = {{"phase", f.phase},
+                {"agent", f.agent},
+                {"block", f.block},
+                {"nees", num(f.nees)},
+                {"band", {num(f.band_lo), num(f.band_hi)}},
+                {"independent_looks", num(f.independent_looks)},
+                {"verdict", f.verdict}};
+    // What the run did not measure (no accepted correspondence, a one-step phase) is left out.
+    const std::pair<const char*, double> measured[] = {{"assumed_accel_sigma", f.assumed_accel_sigma},
+                                                       {"truth_accel", f.truth_accel},
+                                                       {"assumed_pixel_sigma", f.assumed_pixel_sigma},
+                                                       {"pixel_error", f.pixel_error}};
+    for (const auto& [key, v] : measured)
+      if (std::isfinite(v)) row[key] = v;
+    findings.push_back(row);
+  }
   j["consistency"] = {{"blocks_checked", m.consistency.blocks_checked}, {"outside_band", findings}};
 
   j["timings_ms"] = {{"predict", stats(m.timings_ms.predict)},
