@@ -8,10 +8,7 @@
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,10 +36,6 @@ struct CalibrateOptions {
   StepLimit limit;
   bool force = false, quiet = false;
 };
-
-}  // namespace
-
-namespace {
 
 int calibrate_command(const CalibrateOptions& o) {
   if (!o.force && fs::exists(o.out))
