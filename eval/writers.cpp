@@ -395,10 +395,10 @@ void format_consistency(Out& out, const Consistency& c) {
   for (std::size_t i = 0; i < shown; ++i) {
     const ConsistencyFinding& x = *f[i];
     fmt::format_to(out,
-                   "\n  {} {} in {}: NEES {} (band {}-{} of 3, {} independent looks): {}; assumed acceleration "
+                   "\n  {} {} in {}: NEES {} (band {}-{} of 3, {:.0f} independent looks): {}; assumed acceleration "
                    "{} m/s^2 against the truth's {} (worst {} s RMS per axis), pixel sigma {} px against {}",
                    x.agent, x.block, x.phase, cell(x.nees, 0, 3), cell(x.band_lo, 0, 3), cell(x.band_hi, 0, 3),
-                   cell(x.independent_looks, 0, 3), x.verdict, cell(x.assumed_accel_sigma, 0, 3),
+                   x.independent_looks, x.verdict, cell(x.assumed_accel_sigma, 0, 3),
                    cell(x.truth_accel, 0, 3), kAccelerationWindowS, cell(x.assumed_pixel_sigma, 0, 3),
                    cell(x.pixel_error, 0, 3));
   }
