@@ -4,12 +4,14 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <stdexcept>
 
+#include "eval/metrics.hpp"
 #include "sim/settings_yaml.hpp"
 #include "sim/truth.hpp"
 #include "sim/yaml_input.hpp"
@@ -107,17 +109,6 @@ void derive_pixel_noise(RunConfig& cfg, const vision::FrontendNoiseModel& model,
   r.pixel_offset_sigma.derive(d.pixel_offset_sigma, from);
 }
 
-namespace {
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const auto i = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * (v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(i), v.end());
-  return v[i];
-}
-
-}  // namespace
-
 vision::DetectorNoise track_noise(const std::vector<eval::TrackedCorrespondence>& corr) {
   std::map<std::pair<int, std::int64_t>, std::vector<Eigen::Vector2d>> tracks;
   for (const auto& c : corr)
@@ -144,8 +135,9 @@ vision::DetectorNoise track_noise(const std::vector<eval::TrackedCorrespondence>
   d.track_offset_rms = std::sqrt(offset2 / (2.0 * d.tracks));
   // The filter's offset states hold one camera's offset against the initialising camera's.
   d.pixel_offset_sigma = std::sqrt(2.0) * d.track_offset_rms;
-  d.median_error_px = quantile(norms, 0.5);
-  d.p95_error_px = quantile(norms, 0.95);
+  const eval::Stats error = eval::summarise(std::move(norms));
+  d.median_error_px = error.median;
+  d.p95_error_px = error.p95;
   return d;
 }
 
@@ -166,8 +158,8 @@ vision::FrontendNoiseModel read_noise_model(const std::string& path) {
   sim::KeyLocations where;
   sim::read_settings(ctx, sim::Field{root, root.Mark(), ""}, model, &where);
   // A detector that is listed carries every figure the estimator takes.
-  for (const char* name : {"orb", "akaze", "sift", "gftt_orb"}) {
-    const std::string section = fmt::format("detectors.{}", name);
+  for (vision::DetectorKind kind : vision::kDetectorKinds) {
+    const std::string section = fmt::format("detectors.{}", vision::to_string(kind));
     const auto s = where.find(section);
     if (s == where.end()) continue;
     for (const char* key : {"pixel_sigma", "pixel_offset_sigma", "observations"})
@@ -188,8 +180,7 @@ std::string noise_model_yaml(const vision::FrontendNoiseModel& model) {
   vision::FrontendNoiseModel copy = model;
   out << YAML::Key << "made_by" << YAML::Value << copy.made_by;
   out << YAML::Key << "detectors" << YAML::Value << YAML::BeginMap;
-  for (auto kind : {vision::DetectorKind::Orb, vision::DetectorKind::Akaze, vision::DetectorKind::Sift,
-                    vision::DetectorKind::GfttOrb}) {
+  for (vision::DetectorKind kind : vision::kDetectorKinds) {
     vision::DetectorNoise& d = copy.of(kind);
     if (!d.calibrated()) continue;
     sim::settings_detail::Emitter e(out);

@@ -110,9 +110,7 @@ void derive_noise(RunConfig& cfg, const Provenance& prov) {
     try {
       path = sim::resolve_asset(cfg.frontend.noise_model, cfg.source_path, "frontend noise model");
       model = read_noise_model(path);
-    } catch (const sim::ScenarioError& e) {
-      fail_at(prov, cfg, key, fmt::format("frontend.noise_model: {}", e.what()));
-    } catch (const std::runtime_error& e) {
+    } catch (const std::runtime_error& e) {  // the model's own ScenarioError, or not found
       fail_at(prov, cfg, key, fmt::format("frontend.noise_model: {}", e.what()));
     }
   }

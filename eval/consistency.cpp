@@ -27,7 +27,7 @@ std::pair<double, double> chi2_mean_band(int dof, double n_eff) {
 
 namespace {
 
-// The steps of phase p with a finite value of `field` for agent a.
+// Agent a's position (or velocity) NEES over the steps of phase p where it is finite.
 std::vector<double> block_series(const RunRecord& run, int p, std::size_t a, bool velocity) {
   std::vector<double> out;
   for (const StepRecord& s : run.steps) {

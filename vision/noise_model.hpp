@@ -5,6 +5,7 @@
 // scene, and rendered runs that leave pixel_sigma `auto` take their figures from it.
 #pragma once
 
+#include <array>
 #include <string>
 
 #include "geometry/settings.hpp"
@@ -33,6 +34,10 @@ struct DetectorNoise {
     v("p95_error_px", p95_error_px, geometry::in(0, 1000));
   }
 };
+
+// Every detector the model has figures for, in the order the model file lists them.
+inline constexpr std::array<DetectorKind, 4> kDetectorKinds = {DetectorKind::Orb, DetectorKind::Akaze,
+                                                                DetectorKind::Sift, DetectorKind::GfttOrb};
 
 struct FrontendNoiseModel {
   std::string made_by;  // the command that wrote it
