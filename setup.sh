@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Wingman's one entry point for a fresh Debian 12 machine:
-#   bash setup.sh run    install packages, build, run the default scenario (scenes/paper_synthetic.yaml)
+#   bash setup.sh run    install packages, build wingman, run the default scenario (scenes/paper_synthetic.yaml)
 #   bash setup.sh test   install packages, build, run every test (what CI runs)
 #   bash setup.sh build  install packages and build only
 # Environment: BUILD_DIR (default build), JOBS (default: all cores), WINGMAN_SKIP_APT=1 to skip apt.
@@ -39,9 +39,10 @@ install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
+# build [TARGET]: every target, or only TARGET (and what it needs).
 build() {
   cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build "$build_dir" -j "$jobs"
+  cmake --build "$build_dir" -j "$jobs" ${1:+--target "$1"}
 }
 
 case "$mode" in
@@ -51,7 +52,7 @@ case "$mode" in
     ;;
   run)
     install_packages
-    build
+    build wingman  # the tests and benchmarks are built by `test`
     shift || true
     "$build_dir/app/wingman" run scenes/paper_synthetic.yaml --out results/paper_synthetic "$@"
     ;;

@@ -8,7 +8,7 @@
 //   <agent>/mav0/{gps0,altimeter0,range0,ahrs0}/                         noisy sensor samples
 // and a top-level dataset.yaml (format version, scenario, seed, software version). Format version
 // 1 (no mav0/, groundtruth/) is still read (datasets/layout.hpp). The writer fills a directory
-// the caller stages (app/cmd_render.cpp renames it into place when complete); the reader
+// the caller stages (app/cli/cmd_render.cpp renames it into place when complete); the reader
 // validates what it loads and names the file at fault.
 #pragma once
 

@@ -1,7 +1,7 @@
 // The scenario model, sim's part of a run (docs/design.md, settings): truth, sensors, noise and
 // world, loaded from one YAML file by load_scenarios(). Defaults are the paper's section 7 setup;
 // the YAML overrides them. The sections other modules define are kept unread in settings_layers
-// (app/run_config.hpp composes them).
+// (app/config/run_config.hpp composes them).
 #pragma once
 
 #include <Eigen/Core>
@@ -288,7 +288,7 @@ class ScenarioError : public std::runtime_error {
 };
 
 // Loads and validates the scenario's own sections (sim's: truth, sensors, noise, world); the
-// sections other modules define are kept in settings_layers, unread (app/run_config.hpp reads them). A file with `variants:` yields one Scenario per variant
+// sections other modules define are kept in settings_layers, unread (app/config/run_config.hpp reads them). A file with `variants:` yields one Scenario per variant
 // (each the base with that variant's overrides); otherwise exactly one.
 // A scenario file is refused past this size, before it is parsed.
 inline constexpr std::size_t kMaxScenarioBytes = std::size_t{4} << 20;

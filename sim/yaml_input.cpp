@@ -159,12 +159,6 @@ Field MapView::require(std::string_view key, const Loc& map_loc) const {
   ctx_.fail(map_loc, fmt::format("missing required key '{}'", key));
 }
 
-std::string bounds_text(const Bounds& b) {
-  if (b.hi == kInf) return fmt::format("{} {}", b.lo_open ? ">" : ">=", b.lo);
-  if (b.lo == -kInf) return fmt::format("{} {}", b.hi_open ? "<" : "<=", b.hi);
-  return fmt::format("in {}{}, {}{}", b.lo_open ? '(' : '[', b.lo, b.hi, b.hi_open ? ')' : ']');
-}
-
 // ---- Scalars ---------------------------------------------------------------------------------
 
 

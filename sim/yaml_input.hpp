@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "geometry/bounds_check.hpp"
 #include "geometry/camera.hpp"
 #include "geometry/settings.hpp"
 #include "sim/trajectory.hpp"
@@ -96,7 +97,7 @@ using geometry::any_value;
 using geometry::ge;
 using geometry::gt;
 using geometry::in;
-std::string bounds_text(const Bounds& b);
+using geometry::bounds_text;
 
 const std::string& scalar_of(const Ctx& ctx, const Field& f, std::string_view expected);
 double read_number(const Ctx& ctx, const Field& f, Bounds b = any_value());

@@ -20,7 +20,7 @@ enum class EstimatorMode { MultiUav, SingleUav };
 const char* to_string(EstimatorMode m);
 
 // White accelerations of the constant-velocity model (eq. 34), m/s^2. `auto` (the default): from
-// what the scenario flies (app/derived_noise.hpp): the common part from the lead's accelerations,
+// what the scenario flies (app/config/derived_noise.hpp): the common part from the lead's accelerations,
 // each agent's own from its departure from them (a formation that turns with the lead, the noise
 // of noise.motion, the closed loop's disturbance).
 struct ProcessNoiseSettings {

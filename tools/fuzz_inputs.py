@@ -578,7 +578,7 @@ def no_steps(agent) -> bool:
     return isinstance(agent, dict) and agent.get("steps") == 0
 
 
-# Ratios eval/metrics.hpp documents as NaN when their denominator, a sibling counter, is 0.
+# Ratios eval/metrics/metrics.hpp documents as NaN when their denominator, a sibling counter, is 0.
 RATIO_DENOMINATOR = {"accepted_outlier_fraction": "accepted", "lead_detection_rate": "lead_in_view"}
 
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A one-node Slurm cluster on this machine, everything under one directory: for trying
-# `wingman montecarlo --engine slurm` and for its test (tests/app/test_montecarlo_slurm.cpp).
+# `wingman montecarlo --engine slurm` and for its test (tests/app/batch/test_montecarlo_slurm.cpp).
 #   tools/slurm-local.sh start DIR   munged, slurmctld and slurmd, run as root, with their keys,
 #                                    config, state, logs and pid files in DIR; waits until the node
 #                                    is idle and writes the clients' environment into DIR/env

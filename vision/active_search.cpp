@@ -6,14 +6,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "geometry/bounds_check.hpp"
+
 namespace wingman::vision {
 
-void ActiveSearchSettings::validate() const {
-  auto bad = [](const std::string& what) { throw std::invalid_argument("active search settings: " + what); };
-  if (block_px < 16) bad("block_px must be >= 16, got " + std::to_string(block_px));
-  if (!(landmarks_per_block > 0)) bad("landmarks_per_block must be > 0, got " + std::to_string(landmarks_per_block));
-  if (!(max_fraction >= 0 && max_fraction <= 1)) bad("max_fraction must be in [0, 1], got " + std::to_string(max_fraction));
-}
+void ActiveSearchSettings::validate() const { geometry::check_bounds(*this, "active search settings"); }
 
 namespace {
 

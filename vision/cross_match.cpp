@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "geometry/bounds_check.hpp"
+
 namespace wingman::vision {
 
 namespace {
@@ -75,10 +77,9 @@ PairGeometry evaluate_pair(const Eigen::Vector2d& uv_a, const CameraView& a, con
 }
 
 void CrossMatchSettings::validate() const {
+  geometry::check_bounds(*this, "cross-match settings");
+  // Limits of the fields no scenario key sets:
   auto bad = [](const std::string& what) { throw std::invalid_argument("cross-match settings: " + what); };
-  if (!(ratio > 0 && ratio <= 1)) bad("ratio must be in (0, 1], got " + std::to_string(ratio));
-  if (!(max_epipolar_px > 0)) bad("max_epipolar_px must be > 0, got " + std::to_string(max_epipolar_px));
-  if (!(max_reprojection_px > 0)) bad("max_reprojection_px must be > 0, got " + std::to_string(max_reprojection_px));
   if (min_depth < 0) bad("min_depth must be >= 0, got " + std::to_string(min_depth));
   if (min_parallax_deg < 0) bad("min_parallax_deg must be >= 0, got " + std::to_string(min_parallax_deg));
 }

@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "geometry/bounds_check.hpp"
+
 namespace wingman::vision {
 
 DetectorKind parse_detector(std::string_view name) {
@@ -36,17 +38,9 @@ void require(bool ok, const std::string& what) {
 }  // namespace
 
 void FeatureSettings::validate() const {
-  require(max_features > 0, "max_features must be > 0, got " + std::to_string(max_features));
-  require(grid_cols > 0 && grid_rows > 0, "grid must be at least 1 x 1, got " +
-                                              std::to_string(grid_cols) + " x " + std::to_string(grid_rows));
+  geometry::check_bounds(*this, "feature settings");
+  // The limit of the one field no scenario key sets:
   require(oversample >= 1.0, "oversample must be >= 1, got " + std::to_string(oversample));
-  require(orb_levels >= 1, "orb_levels must be >= 1, got " + std::to_string(orb_levels));
-  require(orb_scale_factor > 1.0f, "orb_scale_factor must be > 1, got " + std::to_string(orb_scale_factor));
-  require(orb_fast_threshold > 0, "orb_fast_threshold must be > 0, got " + std::to_string(orb_fast_threshold));
-  require(akaze_threshold > 0, "akaze_threshold must be > 0, got " + std::to_string(akaze_threshold));
-  require(gftt_quality > 0 && gftt_quality < 1, "gftt_quality must be in (0, 1), got " + std::to_string(gftt_quality));
-  require(gftt_min_distance >= 0, "gftt_min_distance must be >= 0, got " + std::to_string(gftt_min_distance));
-  require(sift_contrast > 0, "sift_contrast must be > 0, got " + std::to_string(sift_contrast));
 }
 
 bool ExclusionBox::contains(const Eigen::Vector2d& uv) const {

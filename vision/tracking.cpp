@@ -9,15 +9,16 @@
 #include <stdexcept>
 #include <string>
 
+#include "geometry/bounds_check.hpp"
+
 namespace wingman::vision {
 
 void TrackingSettings::validate() const {
-  auto bad = [](const std::string& what) { throw std::invalid_argument("tracking settings: " + what); };
-  if (!(gate_d2 > 0)) bad("gate_d2 must be > 0, got " + std::to_string(gate_d2));
-  if (!(ratio > 0 && ratio <= 1)) bad("ratio must be in (0, 1], got " + std::to_string(ratio));
-  if (duplicate_radius_px < 0) bad("duplicate_radius_px must be >= 0, got " + std::to_string(duplicate_radius_px));
-  if (max_distance < 0) bad("max_distance must be >= 0 (0 = the descriptor's default), got " + std::to_string(max_distance));
-  if (max_search_radius_px < 0) bad("max_search_radius_px must be >= 0, got " + std::to_string(max_search_radius_px));
+  geometry::check_bounds(*this, "tracking settings");
+  // The limit of the one field no scenario key sets:
+  if (duplicate_radius_px < 0)
+    throw std::invalid_argument("tracking settings: duplicate_radius_px must be >= 0, got " +
+                                std::to_string(duplicate_radius_px));
 }
 
 double default_tracking_distance(const cv::Mat& descriptors) {

@@ -7,7 +7,8 @@
 #include <filesystem>
 #include <string>
 
-#include "eval/run_record.hpp"
+#include "eval/metrics/run_record.hpp"
+#include "io/io_test_support.hpp"
 
 namespace wingman::eval::test {
 
@@ -56,13 +57,13 @@ inline RunRecord make_record() {
     s.nees = k == 5 ? kNaN : k;
     s.nees_dof = 12;
     s.landmarks = k < 3 ? k : 3;
-    s.landmarks_visible = 2;
-    s.matches_offered = 5;
-    s.matches_accepted = 4;
-    s.initialised = k == 1 ? 1 : 0;
-    s.t_predict_ms = k;
-    s.t_update_ms = 2.0 * k;
-    s.t_init_ms = 0;
+    s.counts.landmarks_visible = 2;
+    s.counts.matches_offered = 5;
+    s.counts.matches_accepted = 4;
+    s.counts.initialised = k == 1 ? 1 : 0;
+    s.t_ms.predict = k;
+    s.t_ms.update = 2.0 * k;
+    s.t_ms.init = 0;
     r.steps.push_back(s);
   }
   auto lm = [](std::int64_t id, int phase, Eigen::Vector3d truth, Eigen::Vector3d init_err,
@@ -90,27 +91,6 @@ inline RunRecord make_record() {
   return r;
 }
 
-// A fresh directory under the system temp dir, unique per process and test, removed at exit.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            ("wingman_eval_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-             std::to_string(::getpid()));
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+using io::test::TempDir;
 
 }  // namespace wingman::eval::test

@@ -8,6 +8,7 @@
 
 #include <map>
 #include <memory>
+#include <ostream>
 #include <string>
 
 #include "render/gl_context.hpp"
@@ -44,3 +45,8 @@ inline std::string backend_name(const ::testing::TestParamInfo<GlBackend>& info)
   if (!var##_entry.ctx)                                                                \
     WINGMAN_NO_GL_CONTEXT(std::string("no ") + to_string(backend) + " context: " + var##_entry.why); \
   ::wingman::render::GlContext& var = *var##_entry.ctx
+
+namespace wingman::render {
+// How gtest prints a backend parameter (by name, not as a number).
+inline void PrintTo(GlBackend b, std::ostream* os) { *os << to_string(b); }
+}  // namespace wingman::render

@@ -41,6 +41,20 @@ TEST(Features, BadSettingsThrowNamingTheValue) {
   }
 }
 
+TEST(Features, SettingsSetInCodeAreHeldToTheBoundsOfTheirScenarioKeys) {
+  FeatureSettings s;
+  s.orb_levels = 20;  // frontend.orb.levels is in [1, 16]
+  try {
+    s.validate();
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("orb.levels must be in [1, 16], got 20"), std::string::npos) << e.what();
+  }
+  s = {};
+  s.max_features = 200000;  // frontend.max_features is in [1, 100000]
+  EXPECT_THROW(s.validate(), std::invalid_argument);
+}
+
 class EveryDetector : public ::testing::TestWithParam<DetectorKind> {};
 
 TEST_P(EveryDetector, FindsSpreadDescribedFeaturesOutsideTheExclusionBox) {

@@ -7,12 +7,19 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 
 #include "geometry/camera.hpp"
 #include "geometry/rotation.hpp"
 #include "vision/cross_match.hpp"
+#include "vision/features.hpp"
+
+namespace wingman::vision {
+// How gtest prints a detector parameter (by name, not as a number).
+inline void PrintTo(DetectorKind k, std::ostream* os) { *os << to_string(k); }
+}  // namespace wingman::vision
 
 namespace wingman::vision::test {
 

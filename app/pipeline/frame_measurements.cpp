@@ -1,0 +1,180 @@
+#include "app/pipeline/frame_measurements.hpp"
+
+#include <future>
+
+#include "io/timing.hpp"
+
+namespace wingman::app {
+
+FrameMeasurements::FrameMeasurements(const RunConfig& cfg, const sim::Truth& truth,
+                                     std::unique_ptr<FrameProducer> frames,
+                                     std::unique_ptr<SensorSamples> samples, const FrameOptions& options)
+    : cfg_(cfg),
+      truth_(truth),
+      cam_uav_(cfg.filter_uavs()),
+      frames_(std::move(frames)),
+      samples_(std::move(samples)),
+      frontend_(cfg, cam_uav_, options.features),
+      prefetch_(options.prefetch && frames_->renders()),
+      now_(cam_uav_.size()),
+      lead_(cam_uav_.size()) {
+  record_.enabled = true;
+  record_.detector = frontend_.detector_name();
+  record_.renderer = frames_->description();
+  record_.frames_rendered = frames_->renders();
+  record_.oracle_pixels = cfg.frontend.oracle_pixels;
+  record_.record_correspondences = options.correspondences;
+  if (!options.video.empty()) {
+    std::vector<geometry::PinholeCamera> models;
+    std::vector<std::string> names;
+    for (int j = 0; j < frontend_.num_cameras(); ++j) {
+      models.push_back(frontend_.model(j));
+      names.push_back(cfg.uavs[cam_uav_[j]].name);
+    }
+    video_ = std::make_unique<VideoOverlay>(options.video, models, names, cfg.rate);
+  }
+}
+
+StageTimes FrameMeasurements::begin_step(int k, double t, const slam::Estimator& est) {
+  k_ = k;
+  t_ = t;
+  const StageTimes st = produce_and_detect(k, t, est);
+  record_.detect_busy_ms += st.detect_ms;
+  // Tallies of the lead detector against the truth (evaluation only).
+  const Eigen::Vector3d lead_W = truth_.lead(t).position;
+  for (int j = 0; j < frontend_.num_cameras(); ++j) {
+    lead_[j] = frontend_.lead(j);
+    record_.searched_fraction_sum += frontend_.searched_fraction(j);
+    const auto uv_true = labeller_.lead(lead_[j], frontend_.model(j), now_[j], lead_W, record_);
+    if (uv_true && cfg_.frontend.oracle_pixels) lead_[j] = *uv_true;
+  }
+  return st;
+}
+
+void FrameMeasurements::detect_all(const slam::Estimator& est, StageTimes& st) {
+  for (int j = 0; j < frontend_.num_cameras(); ++j) st.detect_ms += frontend_.detect(j, now_[j].frame, est);
+}
+
+StageTimes FrameMeasurements::produce_and_detect(int k, double t, const slam::Estimator& est) {
+  StageTimes st;
+  const auto t_start = io::Clock::now();
+  frontend_.plan_step(est);  // before any camera detects, on whichever thread
+  const int n = frontend_.num_cameras();
+  const bool ahead = prefetch_ && k < cfg_.num_steps();
+  const bool have = next_.k == k;  // produced during the previous step
+  if (have) {
+    for (int j = 0; j < n; ++j) now_[j] = std::move(next_.frames[j]);
+    next_.k = -1;
+  } else if (ahead) {
+    const auto t0 = io::Clock::now();
+    for (int j = 0; j < n; ++j) frames_->produce(j, k, t, now_[j]);
+    st.render_ms += io::ms_since(t0);
+  }
+  if (have && !ahead) {  // the last step: nothing left to produce
+    detect_all(est, st);
+  } else if (ahead) {
+    // Step k's detection (the cameras one after the other: the extractor is not shared) on a
+    // second thread while this one, which holds the GL context, renders step k+1.
+    auto detection = std::async(std::launch::async, [this, &est] {
+      StageTimes d;
+      detect_all(est, d);
+      return d.detect_ms;
+    });
+    const auto t0 = io::Clock::now();
+    next_.frames.resize(n);
+    for (int j = 0; j < n; ++j) frames_->produce(j, k + 1, (k + 1) * cfg_.dt(), next_.frames[j]);
+    next_.k = k + 1;
+    st.render_ms += io::ms_since(t0);
+    st.detect_ms += detection.get();
+  } else {
+    // Camera j's detection runs on a second thread while camera j+1 is produced (the GL context
+    // stays on this thread; two detections never run at once).
+    std::future<double> pending;
+    for (int j = 0; j < n; ++j) {
+      const auto t0 = io::Clock::now();
+      frames_->produce(j, k, t, now_[j]);
+      st.render_ms += io::ms_since(t0);
+      if (pending.valid()) st.detect_ms += pending.get();
+      pending = std::async(std::launch::async, [this, j, &est] { return frontend_.detect(j, now_[j].frame, est); });
+    }
+    if (pending.valid()) st.detect_ms += pending.get();
+  }
+  st.wall_ms = io::ms_since(t_start);
+  return st;
+}
+
+Labelled<LandmarkObservation> FrameMeasurements::landmarks(int cam,
+                                                           const std::vector<slam::LandmarkPrediction>& preds) {
+  Labelled<LandmarkObservation> out;
+  for (const auto& f : frontend_.track(cam, preds)) {
+    LandmarkObservation o{{cam, f.id, f.uv}, f.keypoint};
+    const auto truth = labeller_.observation(f.id, f.uv, frontend_.model(cam), now_[cam]);
+    TruthLabel label;
+    label.outlier = truth.outlier;
+    label.error_px = truth.error_px;
+    if (truth.true_uv) label.true_uv = *truth.true_uv;
+    if (cfg_.frontend.oracle_pixels && !label.outlier) {  // an inlier has a true projection
+      o.c.uv = *truth.true_uv;
+      label.error_px = 0;
+    }
+    out.add(o, label);
+  }
+  return out;
+}
+
+void FrameMeasurements::verdict(const LandmarkObservation& o, const TruthLabel& label, bool accepted) {
+  if (record_.record_correspondences)
+    record_.correspondences.push_back({k_, t_, o.c.cam, o.c.id, o.c.uv, label.true_uv, label.outlier, accepted});
+  if (!accepted) return;
+  frontend_.accepted(o.c.cam, {o.c.id, o.c.uv, static_cast<int>(o.handle)}, k_);
+  record_.accepted_error_px.push_back(label.error_px);
+}
+
+Labelled<PairObservation> FrameMeasurements::pairs(int cam_a, int cam_b, int needed,
+                                                   const slam::Estimator& est) {
+  Labelled<PairObservation> out;
+  for (const auto& p : frontend_.cross_match(cam_a, cam_b, needed, est)) {
+    PairObservation o{{cam_a, cam_b, p.a.uv, p.b.uv}, p.a.keypoint};
+    const auto truth = labeller_.pair(p.a.uv, frontend_.model(cam_a), now_[cam_a], p.b.uv,
+                                      frontend_.model(cam_b), now_[cam_b]);
+    TruthLabel label;
+    label.outlier = truth.outlier;
+    // Camera a's pixel defines the landmark's truth (added()), so only b's is replaced.
+    if (cfg_.frontend.oracle_pixels && !label.outlier) o.m.uv_b = *truth.true_uv;
+    out.add(o, label);
+  }
+  return out;
+}
+
+std::vector<PointObservation> FrameMeasurements::points(int cam, int needed) {
+  std::vector<PointObservation> out;
+  for (const auto& f : frontend_.new_points(cam, needed)) out.push_back({cam, f.uv, f.keypoint});
+  return out;
+}
+
+std::optional<Eigen::Vector3d> FrameMeasurements::added(slam::LandmarkId id, int cam, std::int64_t handle,
+                                                        const Eigen::Vector2d& uv) {
+  frontend_.added(id, cam, static_cast<int>(handle), k_);
+  return labeller_.landmark(id, uv, frontend_.model(cam), now_[cam]);
+}
+
+void FrameMeasurements::removed(slam::LandmarkId id) {
+  frontend_.removed(id);
+  labeller_.forget(id);
+}
+
+void FrameMeasurements::end_step(double t) {
+  if (!video_) return;
+  std::vector<VideoOverlay::Tile> tiles;
+  for (int j = 0; j < frontend_.num_cameras(); ++j)
+    tiles.push_back({&now_[j].frame, &frontend_.marks(j), lead_[j]});
+  const int phase = cfg_.phase_at(t);
+  video_->write(tiles, t, phase < 0 ? "" : cfg_.phases[static_cast<std::size_t>(phase)].name);
+}
+
+void FrameMeasurements::finish(eval::RunRecord& rec) {
+  frames_->finish(record_);
+  rec.frontend = std::move(record_);
+}
+
+}  // namespace wingman::app

@@ -1,0 +1,75 @@
+// Measurements from frames (`measurements: rendered`, or a dataset's replay): a FrameProducer's
+// frames through the vision frontend, labelled against the truth for evaluation, with the other
+// sensors (GPS, altimeter, range) from SensorSamples (measurements.hpp). Rendering and detection overlap on two
+// threads: camera j's detection with camera j+1's rendering, or, in open loop with prefetch, step
+// k's detection with step k+1's rendering; the results are the same either way.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/pipeline/frame_producer.hpp"
+#include "app/frontend/labeller.hpp"
+#include "app/pipeline/measurements.hpp"
+#include "app/config/run_config.hpp"
+#include "app/frontend/video_overlay.hpp"
+#include "app/frontend/vision_frontend.hpp"
+#include "sim/synthetic_source.hpp"
+#include "sim/truth.hpp"
+
+namespace wingman::app {
+
+struct FrameOptions {
+  bool prefetch = false;        // render step k+1 during step k (open loop, renderer only)
+  bool correspondences = false;  // keep every tracked correspondence (RunRecord::frontend)
+  std::string video;             // non-empty: VideoOverlay to this file
+  std::optional<vision::FeatureSettings> features;  // overrides the frontend section's detector
+};
+
+class FrameMeasurements final : public MeasurementSource {
+ public:
+  FrameMeasurements(const RunConfig& cfg, const sim::Truth& truth, std::unique_ptr<FrameProducer> frames,
+                    std::unique_ptr<SensorSamples> samples, const FrameOptions& options);
+
+  StageTimes begin_step(int k, double t, const slam::Estimator& est) override;
+  Labelled<LandmarkObservation> landmarks(int cam, const std::vector<slam::LandmarkPrediction>& preds) override;
+  std::optional<Eigen::Vector2d> lead_pixel(int cam) override { return lead_[cam]; }
+  slam::SensorBatch sensors(const SensorRequest& wanted) override {
+    return take_samples(*samples_, wanted, cam_uav_, k_, t_);
+  }
+  void verdict(const LandmarkObservation& o, const TruthLabel& label, bool accepted) override;
+  Labelled<PairObservation> pairs(int cam_a, int cam_b, int needed, const slam::Estimator& est) override;
+  std::vector<PointObservation> points(int cam, int needed) override;
+  std::optional<Eigen::Vector3d> added(slam::LandmarkId id, int cam, std::int64_t handle,
+                                       const Eigen::Vector2d& uv) override;
+  void removed(slam::LandmarkId id) override;
+  void end_step(double t) override;
+  void finish(eval::RunRecord& rec) override;
+
+ private:
+  StageTimes produce_and_detect(int k, double t, const slam::Estimator& est);
+  void detect_all(const slam::Estimator& est, StageTimes& st);
+
+  const RunConfig& cfg_;
+  const sim::Truth& truth_;
+  std::vector<int> cam_uav_;
+  std::unique_ptr<FrameProducer> frames_;
+  std::unique_ptr<SensorSamples> samples_;
+  VisionFrontend frontend_;
+  GroundTruthLabeller labeller_;
+  std::unique_ptr<VideoOverlay> video_;
+  bool prefetch_ = false;
+  int k_ = 0;
+  double t_ = 0;
+  std::vector<CameraFrame> now_;                   // this step's frames, per filter camera
+  std::vector<std::optional<Eigen::Vector2d>> lead_;  // this step's lead pixel, per camera
+  struct Prefetched {
+    int k = -1;  // the step they belong to; -1: none
+    std::vector<CameraFrame> frames;
+  } next_;
+  eval::FrontendRecord record_;
+};
+
+}  // namespace wingman::app

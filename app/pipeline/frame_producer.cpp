@@ -1,0 +1,93 @@
+#include "app/pipeline/frame_producer.hpp"
+
+#include <fmt/core.h>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "datasets/dataset.hpp"
+#include "render/effects.hpp"
+#include "render/frame_cache.hpp"
+#include "render/renderer.hpp"
+#include "render/scene.hpp"
+
+namespace wingman::app {
+
+RendererFrames::RendererFrames(const RunConfig& cfg, std::vector<int> cam_uav, render::GlBackend backend,
+                               const sim::Truth& truth, const FrameCacheOptions& cache)
+    : cfg_(cfg), cam_uav_(std::move(cam_uav)), truth_(truth) {
+  scene_ = std::make_unique<render::Scene>();
+  try {
+    *scene_ = render::build_scene(sim::describe_world(cfg));
+  } catch (const std::runtime_error& e) {  // a missing or broken asset: the scenario's fault
+    throw std::invalid_argument(cfg.source_path + ": world: " + e.what());
+  }
+  ctx_ = render::create_gl_context(backend);
+  if (!cache.dir.empty()) {
+    // The context's description (driver and its version) keys the frames: another GL stack may
+    // draw other pixels.
+    keyer_ = std::make_unique<render::FrameKeyer>(*scene_, ctx_->description());
+    cache_ = std::make_unique<render::FrameCache>(cache.dir, cache.max_bytes);
+    cache_->on_warning([](const std::string& w) { fmt::print(stderr, "warning: {}\n", w); });
+  } else {
+    renderer_ = std::make_unique<render::Renderer>(*ctx_, *scene_);
+    scene_.reset();
+  }
+  for (int u : cam_uav_) {
+    models_.push_back(cfg.uavs[u].camera.camera());
+    effects_.push_back(std::make_unique<render::ImageEffects>(cfg.world.image, cfg.seed, cfg.uavs[u].name));
+  }
+}
+
+RendererFrames::~RendererFrames() = default;
+
+std::string RendererFrames::description() const { return ctx_->description(); }
+
+render::Frame RendererFrames::render(const render::CameraView& view, const render::LeadPose& lead) {
+  if (!renderer_) {  // the first frame the cache did not hold
+    renderer_ = std::make_unique<render::Renderer>(*ctx_, *scene_);
+    scene_.reset();
+  }
+  return renderer_->render(view, lead);
+}
+
+void RendererFrames::produce(int cam, int, double t, CameraFrame& out) {
+  const int u = cam_uav_[cam];
+  const render::LeadPose lead = sim::lead_pose(truth_, t, cfg_.world);
+  out.true_pose = {truth_.camera_R_CW(u, t), truth_.camera(u, t).position};
+  const render::CameraView view{models_[cam], out.true_pose};
+  if (!cache_) {
+    out.frame = render(view, lead);
+  } else {
+    const render::FrameKey key = keyer_->key(view, lead);
+    if (auto cached = cache_->load(key)) {
+      out.frame = std::move(*cached);
+    } else {
+      out.frame = render(view, lead);
+      cache_->store(key, out.frame);
+    }
+  }
+  effects_[cam]->apply(out.frame);
+}
+
+void RendererFrames::finish(eval::FrontendRecord& rec) const {
+  if (!cache_) return;
+  const render::FrameCacheStats& s = cache_->stats();
+  rec.frame_cache = {true, cache_->dir().string(), s.hits, s.misses, s.corrupt, s.stores, s.evicted,
+                     s.read_ms, s.write_ms, static_cast<double>(s.bytes_read), static_cast<double>(s.bytes_written)};
+}
+
+DatasetFrames::DatasetFrames(const datasets::Dataset& ds, std::vector<const datasets::AgentData*> agents,
+                             std::vector<int> cam_uav, const sim::Truth& truth)
+    : ds_(ds), agents_(std::move(agents)), cam_uav_(std::move(cam_uav)), truth_(truth) {}
+
+void DatasetFrames::produce(int cam, int k, double t, CameraFrame& out) {
+  const int u = cam_uav_[cam];
+  const datasets::AgentData& a = *agents_[cam];
+  out.true_pose = {truth_.camera_R_CW(u, t), truth_.camera(u, t).position};
+  cv::Mat img = ds_.load_image(a.name, a.frames[k]);
+  if (img.channels() == 1) cv::cvtColor(img, img, cv::COLOR_GRAY2RGB);
+  out.frame.rgb = img;
+  out.frame.depth = ds_.load_depth(a.name, a.frames[k]);
+}
+
+}  // namespace wingman::app

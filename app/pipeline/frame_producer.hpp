@@ -1,0 +1,99 @@
+// Where a run's frames come from: the off-screen renderer (every UAV camera at its true pose,
+// with the lead at its true pose and the image effects) or a dataset written by `wingman
+// render`. Either gives each frame with the true pose it was taken from, for the labeller.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/frontend/labeller.hpp"
+#include "app/config/run_config.hpp"
+#include "eval/metrics/run_record.hpp"
+#include "render/gl_context.hpp"
+#include "sim/truth.hpp"
+
+namespace wingman::datasets {
+struct Dataset;
+struct AgentData;
+}  // namespace wingman::datasets
+
+namespace wingman::render {
+class ImageEffects;
+class Renderer;
+class FrameCache;
+class FrameKeyer;
+struct Scene;
+struct CameraView;
+struct Frame;
+}  // namespace wingman::render
+
+namespace wingman::app {
+
+class FrameProducer {
+ public:
+  virtual ~FrameProducer() = default;
+  // Filter camera `cam`'s frame of step k at time t.
+  virtual void produce(int cam, int k, double t, CameraFrame& out) = 0;
+  virtual std::string description() const = 0;
+  // Whether step k+1 may be produced during step k (the renderer in open loop, whose truth is
+  // known in advance).
+  virtual bool renders() const = 0;
+  // Adds how the frames were got (the frame cache's use) to the run's record.
+  virtual void finish(eval::FrontendRecord&) const {}
+};
+
+// A frame cache for RendererFrames (render/frame_cache.hpp): its directory and size bound.
+struct FrameCacheOptions {
+  std::string dir;  // empty: no cache
+  std::uint64_t max_bytes = 0;
+};
+
+// Renders each filter camera (UAV cam_uav[j]) with an OpenGL context of `backend`; throws
+// std::invalid_argument naming the scenario for a broken world, render::GlError when no context.
+// With a frame cache, a frame the cache holds is read back instead of rendered (the image effects
+// are applied either way), and the scene is uploaded to the context only when a frame misses.
+class RendererFrames final : public FrameProducer {
+ public:
+  RendererFrames(const RunConfig& cfg, std::vector<int> cam_uav, render::GlBackend backend,
+                 const sim::Truth& truth, const FrameCacheOptions& cache = {});
+  ~RendererFrames() override;
+  void produce(int cam, int k, double t, CameraFrame& out) override;
+  std::string description() const override;
+  bool renders() const override { return true; }
+  void finish(eval::FrontendRecord& rec) const override;
+
+ private:
+  render::Frame render(const render::CameraView& view, const render::LeadPose& lead);
+
+  const RunConfig& cfg_;
+  std::vector<int> cam_uav_;
+  const sim::Truth& truth_;
+  std::vector<geometry::PinholeCamera> models_;
+  std::unique_ptr<render::Scene> scene_;  // until the renderer is made
+  std::unique_ptr<render::GlContext> ctx_;
+  std::unique_ptr<render::Renderer> renderer_;
+  std::vector<std::unique_ptr<render::ImageEffects>> effects_;
+  std::unique_ptr<render::FrameKeyer> keyer_;
+  std::unique_ptr<render::FrameCache> cache_;
+};
+
+// Loads each filter camera's frames from a dataset; the true poses are the scenario's truth,
+// which run_replay checks against the dataset's own.
+class DatasetFrames final : public FrameProducer {
+ public:
+  DatasetFrames(const datasets::Dataset& ds, std::vector<const datasets::AgentData*> agents,
+                std::vector<int> cam_uav, const sim::Truth& truth);
+  void produce(int cam, int k, double t, CameraFrame& out) override;
+  std::string description() const override { return "dataset replay"; }
+  bool renders() const override { return false; }
+
+ private:
+  const datasets::Dataset& ds_;
+  std::vector<const datasets::AgentData*> agents_;  // per filter camera
+  std::vector<int> cam_uav_;
+  const sim::Truth& truth_;
+};
+
+}  // namespace wingman::app
