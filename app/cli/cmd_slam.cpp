@@ -40,34 +40,48 @@ struct SlamOptions {
   bool quiet = false;
 };
 
-// One variant's replay into `out` (or, with several variants, out/<variant>).
-int slam_command(const SlamOptions& o, const std::string& variant) {
-  Replay replay = load_replay(o.dataset, variant, o.quiet);
-  apply_step_limit(o.limit, replay.scenario);
-  const datasets::Dataset& ds = replay.dataset;
+// One variant's replay into `dir`: the files of `wingman run`'s variant directory.
+void replay_variant(const SlamOptions& o, const Replay& replay, const fs::path& dir) {
   const RunConfig& scn = replay.scenario;
-  if (!o.no_plots && !eval::gnuplot_available())
-    throw io::UsageError("gnuplot with the pngcairo terminal was not found; install it or pass --no-plots");
-
-  fs::path out = o.out.empty() ? fs::path("results") / (scn.name + "_replay") : fs::path(o.out);
-  if (o.variants.size() > 1) out /= scn.variant;
-  std::optional<io::ResultsDir> staged;
-  stage_output(staged, out, "results", o.force);
-  io::ProgressLine progress(fmt::format("[slam {}]", scn.name), o.quiet);
+  io::ProgressLine progress(fmt::format("[slam {}]", scn.variant.empty() ? scn.name : scn.name + "/" + scn.variant),
+                            o.quiet);
   eval::RunRecord rec;
   try {
-    rec = run_replay(scn, ds, [&](int k, int n) { progress.update(k, n, "steps"); }, std::nullopt,
+    rec = run_replay(scn, replay.dataset, [&](int k, int n) { progress.update(k, n, "steps"); }, std::nullopt,
                      o.correspondences);
   } catch (const std::invalid_argument& e) {
     throw io::UsageError(e.what());
   }
   progress.finish();
+  fs::create_directories(dir);
   const eval::Metrics metrics = eval::compute_metrics(rec);
-  eval::write_results(metrics, rec, staged->staging());
-  if (!o.no_plots) eval::write_plots(rec, staged->staging());
-  copy_scenario(scn, staged->staging());
+  eval::write_results(metrics, rec, dir);
+  write_config(scn, dir / "config.yaml");
+  if (!o.no_plots) eval::write_plots(rec, dir);
+  if (!o.quiet) fmt::print("{}\n", eval::format_summary(metrics, rec));
+}
+
+// Every variant asked for (or the dataset's own) into one results directory laid out as
+// `wingman run` lays it out: OUT/<variant>/ for a scenario with variants, OUT/ otherwise.
+int slam_command(const SlamOptions& o) {
+  if (!o.no_plots && !eval::gnuplot_available())
+    throw io::UsageError("gnuplot with the pngcairo terminal was not found; install it or pass --no-plots");
+  std::vector<Replay> replays;
+  for (const std::string& v : o.variants.empty() ? std::vector<std::string>{""} : o.variants) {
+    replays.push_back(load_replay(o.dataset, v, o.quiet));
+    apply_step_limit(o.limit, replays.back().scenario);
+  }
+  const RunConfig& first = replays.front().scenario;
+  const fs::path out = o.out.empty() ? fs::path("results") / (first.name + "_replay") : fs::path(o.out);
+  std::optional<io::ResultsDir> staged;
+  stage_output(staged, out, "results", o.force);
+  for (const Replay& r : replays) {
+    const bool nested = replays.size() > 1 || !r.scenario.variant.empty();
+    replay_variant(o, r, nested ? staged->staging() / r.scenario.variant : staged->staging());
+  }
+  copy_scenario(first, staged->staging());
   staged->commit();
-  if (!o.quiet) fmt::print("{}\nresults: {}\n", eval::format_summary(metrics, rec), out.string());
+  if (!o.quiet) fmt::print("results: {}\n", out.string());
   return 0;
 }
 
@@ -82,8 +96,8 @@ Subcommand add_slam(CLI::App& parent) {
   cmd->add_option("--out,-o", o->out, "Results directory (default: results/<scenario>_replay)");
   add_variant_option(cmd, o->variants,
                      "Estimator settings of this variant of the dataset's scenario (default: the "
-                     "variant it was rendered with, else the first; with several, one results "
-                     "directory each, OUT/<variant>)");
+                     "variant it was rendered with, else the first); each variant's results go to "
+                     "OUT/<variant>, as `wingman run` writes them");
   add_step_limit(cmd, o->limit);
   cmd->add_flag("--no-plots", o->no_plots, "Skip the PNG plots (no gnuplot needed)");
   cmd->add_flag("--correspondences", o->correspondences,
@@ -91,7 +105,7 @@ Subcommand add_slam(CLI::App& parent) {
                 "filter with its true projection, label and fate (as `wingman run`)");
   add_force_flag(cmd, o->force);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line and no summary");
-  return {cmd, [o] { return for_each_variant(o->variants, [&](const std::string& v) { return slam_command(*o, v); }); }};
+  return {cmd, [o] { return slam_command(*o); }};
 }
 
 }  // namespace wingman::app

@@ -384,6 +384,29 @@ void write_monte_carlo(const std::vector<MonteCarloSummary>& summaries, const fs
   io::write_file_atomic(dir / "nees.csv", csv);
 }
 
+namespace {
+
+// What a phase with few steps inside its bounds says about the filter: too little NEES is a filter
+// that assumes more noise than the runs realise, too much one that trusts its estimate too far.
+std::string why_outside(const MonteCarloSummary& m) {
+  std::string s;
+  for (const auto& p : m.phases) {
+    if (!(p.fraction_inside < kInsideTarget) || !std::isfinite(p.mean_nees)) continue;
+    if (p.mean_nees < m.lower)
+      s += fmt::format("{}: mean NEES {:.2f} lies below the bounds: the filter assumes more noise than the "
+                       "runs realise (a truth that never draws the process noise, as the paper's "
+                       "deterministic eq. 66, does this; docs/studies/nees-consistency.md)\n",
+                       p.name, p.mean_nees);
+    else if (p.mean_nees > m.upper)
+      s += fmt::format("{}: mean NEES {:.2f} lies above the bounds: the filter's covariance is smaller than "
+                       "its errors (overconfident)\n",
+                       p.name, p.mean_nees);
+  }
+  return s;
+}
+
+}  // namespace
+
 std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries) {
   std::string s;
   for (const auto& m : summaries) {
@@ -400,6 +423,7 @@ std::string format_monte_carlo(const std::vector<MonteCarloSummary>& summaries) 
         for (const auto& sp : a.mse) s += fmt::format(" {:>7.4f}±{:<7.4f}", sp.mean, sp.std);
       s += "\n";
     }
+    s += why_outside(m);
     s += fmt::format("consistency (a consistent filter averages {}; its NEES decorrelates over {:.1f} s):\n",
                      m.dof, m.nees_correlation_time);
     s += fmt::format("{:<10} {:>8} {:>24} {:>29} {:>16}\n", "phase", "inside", "mean NEES [95% CI]",

@@ -1,5 +1,6 @@
 // `wingman render` end to end: a small scenario renders into a dataset that reads back and
 // whose frames equal a direct render; bad input exits 2 naming the file; Ctrl-C leaves nothing.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -36,6 +37,31 @@ std::string tiny_scenario(double duration, const std::string& world = "{texture:
   s += world;
   s += "\n";
   return s;
+}
+
+// Without --out a dataset lands under results/ (ignored by git), never among the sources; a
+// rendered run and a replay of it say where their frames came from, and a replay calls loading
+// its frames what it is.
+TEST(RenderCli, DefaultOutputIsUnderResultsAndSummariesNameTheFramesSource) {
+  TempDir tmp;
+  const fs::path scn = tmp / "tiny.yaml";
+  write_file(scn, tiny_scenario(0.2) + "measurements: rendered\n");
+  const auto r = run_wingman({"render", scn.string(), "--gl", "osmesa", "-q"}, tmp.path(), tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path ds = tmp / "results" / "datasets" / "tiny";
+  EXPECT_TRUE(fs::exists(ds / "dataset.yaml")) << r.output;
+
+  const auto run = run_wingman({"run", scn.string(), "--gl", "osmesa", "--no-plots", "--out", (tmp / "run").string()},
+                               tmp.path());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, ::testing::HasSubstr("Frames from: "));
+  EXPECT_THAT(run.output, ::testing::HasSubstr("Stages [ms/step, mean]: render "));
+  const auto replay = run_wingman({"slam", ds.string(), "--no-plots", "--out", (tmp / "replay").string()}, tmp.path());
+  ASSERT_EQ(replay.exit_code, 0) << replay.output;
+  EXPECT_THAT(replay.output, ::testing::HasSubstr("Frames from: dataset replay"));
+  EXPECT_THAT(replay.output, ::testing::HasSubstr("Stages [ms/step, mean]: load frames "));
+  // The same count in the progress line's last state and the summary: t = 0 and 2 more steps.
+  EXPECT_THAT(replay.output, ::testing::HasSubstr(", 3 steps,"));
 }
 
 TEST(RenderCli, WritesADatasetThatReadsBackAndMatchesADirectRender) {

@@ -8,6 +8,8 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "app/app_test_support.hpp"
@@ -250,6 +252,74 @@ TEST_F(ScoreMatchesCli, BenchFrontendScoresBuiltInDetectorsThroughTheFileFormat)
   ASSERT_EQ(bench_akaze.at("name"), "akaze");
   EXPECT_EQ(k.at("methods").at(0).at("name"), "akaze");
   EXPECT_EQ(k.at("methods").at(0).at("groups"), bench_akaze.at("groups"));
+}
+
+// --frames means the same on pairs, bench-frontend and score-matches: the same pairs, said when
+// some are left out, and recorded in scores.json with the matcher's options where there is one.
+TEST_F(ScoreMatchesCli, TheSameLimitKeepsTheSamePairsOnEveryCommand) {
+  // Frames 0..5 of 11: per UAV the temporal pairs (0, 1) and (0, 5), and the cross pair at 0.
+  const RunResult pairs = run_wingman({"pairs", ds().string(), "--frames", "6"}, tmp());
+  ASSERT_EQ(pairs.exit_code, 0) << pairs.output;
+  EXPECT_THAT(pairs.output, HasSubstr("pairs: 5 of 8 within --duration/--frames; the 3 past it are left out"));
+  EXPECT_EQ(std::count(pairs.output.begin(), pairs.output.end(), '\n'), 1 + 5 + 1) << pairs.output;
+
+  const fs::path bench = tmp() / "bench_limited";
+  fs::remove_all(bench);
+  const RunResult b = run_wingman({"bench-frontend", ds().string(), "--detector", "orb", "--frames", "6",
+                                   "--ratio", "0.7", "--no-mutual", "--out", bench.string(), "--no-plots"},
+                                  tmp());
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_THAT(b.output, HasSubstr("pairs: 5 of 8 within --duration/--frames"));
+  const auto j = read_json(bench / "scores.json");
+  EXPECT_EQ(j.at("pairs"), 5);
+  EXPECT_EQ(j.at("limit").at("frames"), 6);
+  EXPECT_DOUBLE_EQ(j.at("matcher").at("ratio").get<double>(), 0.7);
+  EXPECT_EQ(j.at("matcher").at("mutual"), false);
+  EXPECT_GT(j.at("matcher").at("max_features").get<int>(), 0);
+
+  const fs::path rescored = tmp() / "rescored_limited";
+  fs::remove_all(rescored);
+  const RunResult s = run_wingman({"score-matches", ds().string(), (bench / "frontends" / "orb").string(),
+                                   "--frames", "6", "--out", rescored.string(), "--no-plots", "-q"},
+                                  tmp());
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const auto k = read_json(rescored / "scores.json");
+  EXPECT_EQ(k.at("pairs"), 5);
+  EXPECT_EQ(k.at("limit").at("frames"), 6);
+  EXPECT_TRUE(k.at("matcher").is_null());  // a frontend's own matches: the benchmark did not make them
+  EXPECT_EQ(k.at("methods").at(0).at("groups"), j.at("methods").at(0).at("groups"));
+}
+
+// A frontend's timings.csv gives it the ms-per-frame figure the built-in detectors get.
+TEST_F(ScoreMatchesCli, AFrontendsTimingsFileGivesItsMsPerFrame) {
+  const fs::path sub = known_submission(ds(), tmp(), "timed");
+  write_file(sub / "timings.csv", "agent,t_ns,ms\nuav1,0,10\nuav1,500000000,20\nuav2,0,30\nuav2,100000000,99\n");
+  const fs::path out = tmp() / "timed_scores";
+  fs::remove_all(out);
+  const RunResult r = run_wingman({"score-matches", ds().string(), sub.string(), "--pairs",
+                                   (tmp() / "pairs.csv").string(), "--out", out.string(), "--no-plots", "-q"},
+                                  tmp());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The three frames the two pairs use: (10 + 20 + 30) / 3.
+  EXPECT_DOUBLE_EQ(read_json(out / "scores.json").at("methods").at(0).at("detect_ms_per_frame").get<double>(), 20.0);
+
+  write_file(sub / "timings.csv", "agent,t_ns,ms\nuav1,0,10\n");
+  fs::remove_all(out);
+  const RunResult missing = run_wingman({"score-matches", ds().string(), sub.string(), "--pairs",
+                                         (tmp() / "pairs.csv").string(), "--out", out.string(), "--no-plots", "-q"},
+                                        tmp());
+  EXPECT_EQ(missing.exit_code, 2) << missing.output;
+  EXPECT_THAT(missing.output, HasSubstr("timings.csv: no time for frame"));
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(ScoreMatchesCli, HelpShowsFlagsWithoutAnInternalDefault) {
+  const RunResult r = run_wingman({"bench-frontend", "--help"}, tmp());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--no-mutual"));
+  EXPECT_THAT(r.output, ::testing::Not(HasSubstr("{false}")));
+  for (const char* cmd : {"pairs", "score-matches", "bench-frontend"})
+    EXPECT_THAT(run_wingman({cmd, "--help"}, tmp()).output, HasSubstr("--frames")) << cmd;
 }
 
 TEST_F(ScoreMatchesCli, BenchFrontendWritesThePlotWhenGnuplotIsPresent) {

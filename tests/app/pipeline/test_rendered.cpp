@@ -229,14 +229,17 @@ TEST(RenderedPipeline, SlamAndBenchFrontendReplayARenderedDataset) {
                    (dir / "res").string()},
                   dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string metrics = read_file(dir / "res" / "metrics.json");
+  const std::string metrics = read_file(dir / "res" / "multi" / "metrics.json");
   EXPECT_THAT(metrics, ::testing::HasSubstr("\"lead_detection_rate\": 1.0"));
   EXPECT_THAT(metrics, ::testing::HasSubstr("\"render\""));
-  EXPECT_TRUE(fs::exists(dir / "res" / "landmarks.csv"));
+  EXPECT_TRUE(fs::exists(dir / "res" / "multi" / "landmarks.csv"));
+  // The layout of `wingman run`: the variant's directory with its config.yaml, the scenario beside it.
+  EXPECT_TRUE(fs::exists(dir / "res" / "multi" / "config.yaml"));
+  EXPECT_TRUE(fs::exists(dir / "res" / "scenario.yaml"));
   {
     // --correspondences on a replay: the header and the tracked correspondences of 10 steps (two
     // cameras, about 20 landmarks each).
-    const std::string csv = read_file(dir / "res" / "correspondences.csv");
+    const std::string csv = read_file(dir / "res" / "multi" / "correspondences.csv");
     EXPECT_EQ(csv.rfind("k,t,cam,landmark,u,v,true_u,true_v,outlier,accepted\n", 0), 0u);
     EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 10);
   }

@@ -266,3 +266,29 @@ TEST(MonteCarlo, RunSetReadsEachMetricsFileOnce) {
     EXPECT_NE(std::string(e.what()).find((dirs[0] / "metrics.json").string()), std::string::npos) << e.what();
   }
 }
+
+// A phase with few steps inside its bounds is explained by which side of them its NEES lies.
+TEST(MonteCarlo, SummarySaysWhyAPhaseLiesOutsideItsBounds) {
+  MonteCarloSummary m;
+  m.label = "multi";
+  m.runs = 4;
+  m.dof = 18;
+  m.lower = 16.0;
+  m.upper = 20.0;
+  MonteCarloPhase low, high, fine;
+  low.name = "phase1";
+  low.mean_nees = 9.0;
+  low.fraction_inside = 0.0;
+  high.name = "phase2";
+  high.mean_nees = 40.0;
+  high.fraction_inside = 0.1;
+  fine.name = "phase3";
+  fine.mean_nees = 18.0;
+  fine.fraction_inside = 0.95;
+  m.phases = {low, high, fine};
+  const std::string table = format_monte_carlo({m});
+  EXPECT_NE(table.find("phase1: mean NEES 9.00 lies below the bounds: the filter assumes more noise"),
+            std::string::npos) << table;
+  EXPECT_NE(table.find("phase2: mean NEES 40.00 lies above the bounds"), std::string::npos) << table;
+  EXPECT_EQ(table.find("phase3: mean NEES"), std::string::npos) << table;
+}
