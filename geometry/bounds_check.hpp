@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "geometry/settings.hpp"
 
@@ -44,6 +45,18 @@ class BoundsChecker {
     check(key, a, bounds);
     check(key, b, bounds);
   }
+  template <typename T>
+  void list(std::string_view key, std::vector<T>& items, ListNames) {
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      BoundsChecker sub(what_, path(key) + "[" + std::to_string(i) + "].");
+      items[i].visit(sub);
+    }
+  }
+  // What the scenario reader alone checks: conditions on the file's values, required keys.
+  void check(std::string_view, bool, std::string_view) {}
+  void required(std::string_view) {}
+  void optional(std::string_view, std::string&) {}
+  void other(std::string_view) {}
 
  private:
   std::string path(std::string_view key) const { return prefix_ + std::string(key); }

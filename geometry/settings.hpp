@@ -14,6 +14,10 @@
 //   v(key, AutoNumber&, Bounds)  (a number or `auto`)
 //   v.choice(key, E&, {{"name", E::Value}, ...})
 //   v.section(key, [&](auto& sub) { ... })
+//   v.list(key, std::vector<T>&, ListNames)   (a list of maps, each T with its own visit())
+//   v.optional(key, std::string&)              (written only when set)
+//   v.required(key)                            (the reader fails when the key is absent)
+//   v.check(key, ok, what)                     (a condition on the values read so far)
 // Keys are YAML keys; the struct's field names may differ (the code's names stay frame- and
 // unit-explicit).
 #pragma once
@@ -81,6 +85,12 @@ struct AutoNumber {
     value = v;
     source = std::move(why);
   }
+};
+
+// How a list of maps is named in messages, and how many items it needs at least.
+struct ListNames {
+  std::string_view plural, singular;
+  std::size_t min_items = 0;
 };
 
 // The names an enum takes in files, in the order they are listed to a user.

@@ -17,6 +17,7 @@
 #include "geometry/camera.hpp"
 #include "geometry/settings.hpp"
 #include "sim/control_spec.hpp"
+#include "sim/sensors.hpp"
 #include "sim/trajectory.hpp"
 #include "sim/world.hpp"
 
@@ -24,16 +25,6 @@ namespace wingman::sim {
 
 struct SettingsLayer;  // sim/yaml_input.hpp
 
-// Measurement kinds a configuration switches on or off (Table 1).
-enum class Sensor { Landmarks, LeadProjection, Altimeter, Range, Gps };
-const char* to_string(Sensor s);
-std::optional<Sensor> sensor_from_string(const std::string& s);
-
-// Table 1 presets; Integrated feeds everything available at that instant.
-enum class Config { C1, C2, C3, Integrated };
-const char* to_string(Config c);
-// The sensor set of a configuration preset.
-std::vector<Sensor> sensors_of(Config c);
 
 // Synthetic: projections of a point field with the paper's noise; Rendered: rendered frames
 // through the vision frontend (app/).
@@ -228,6 +219,13 @@ struct LandmarkFieldSpec {
   }
 };
 
+// What is wrong with a window [from, to) of a phase or an outage (to must exceed from), a phase's
+// name, or a phase's add and remove lists (the index of a sensor in both, else -1); "" when
+// nothing is.
+std::string window_problem(double from, double to);
+std::string phase_name_problem(const std::string& name);
+int added_and_removed(const std::vector<Sensor>& add, const std::vector<Sensor>& remove);
+
 // A time window with a configuration; `add` and `remove` adjust its preset.
 struct Phase {
   std::string name;
@@ -236,14 +234,52 @@ struct Phase {
   std::vector<Sensor> add, remove;
   std::string source;   // its key path in the file ("phases[1]"); empty for the default phase
   int source_line = 0;  // 1-based line of its entry; 0 for the default phase
+
+  static Phase list_item(std::size_t i) {
+    Phase p;
+    p.name = "phase" + std::to_string(i + 1);
+    return p;
+  }
+  template <class V>
+  void visit(V& v) {
+    v("name", name);
+    v.check("name", phase_name_problem(name).empty(), phase_name_problem(name));
+    v.required("from");
+    v("from", t_start, geometry::ge(0));
+    v.required("to");
+    v("to", t_end);
+    v.check("to", window_problem(t_start, t_end).empty(), window_problem(t_start, t_end));
+    v.required("config");
+    v("config", config);
+    v("add", add);
+    v("remove", remove);
+    const int both = added_and_removed(add, remove);
+    v.check("remove[" + std::to_string(both) + "]", both < 0,
+            both < 0 ? "" : std::string("sensor '") + to_string(remove[static_cast<std::size_t>(both)]) +
+                                "' is both added and removed");
+  }
 };
+inline constexpr geometry::ListNames kPhaseList{"phases", "phase", 1};
 
 // A sensor switched off for a window; agent empty means every agent carrying it.
 struct Outage {
   Sensor sensor = Sensor::Gps;
   double t_start = 0, t_end = 0;
   std::string agent;
+
+  template <class V>
+  void visit(V& v) {
+    v.required("sensor");
+    v("sensor", sensor);
+    v.required("from");
+    v("from", t_start, geometry::ge(0));
+    v.required("to");
+    v("to", t_end);
+    v.check("to", window_problem(t_start, t_end).empty(), window_problem(t_start, t_end));
+    v.optional("agent", agent);
+  }
 };
+inline constexpr geometry::ListNames kOutageList{"outages", "outage", 0};
 
 
 struct Scenario {

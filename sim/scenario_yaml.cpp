@@ -58,34 +58,6 @@ std::string short_name(const std::string& s) {
   return s.size() > 80 ? s.substr(0, 80) + fmt::format("... ({} bytes)", s.size()) : s;
 }
 
-const std::vector<std::string_view> kSensorNames = {"landmarks", "lead_projection", "altimeter",
-                                                    "range", "gps"};
-
-Sensor read_sensor(const Ctx& ctx, const Field& f) {
-  const std::string& s = scalar_of(ctx, f, "a sensor name");
-  if (auto k = sensor_from_string(s)) return *k;
-  ctx.fail(f.loc(), fmt::format("unknown sensor '{}'{}; expected one of {}", s,
-                                suggestion(s, kSensorNames), join(kSensorNames)));
-}
-
-std::vector<Sensor> read_sensor_list(const Ctx& ctx, const Field& f) {
-  if (!f.node.IsSequence())
-    ctx.fail(f.loc(), fmt::format("expected a list of sensor names, got {}", describe(f.node)));
-  std::vector<Sensor> out;
-  for (std::size_t i = 0; i < f.node.size(); ++i)
-    out.push_back(read_sensor(ctx, Field{f.node[i], f.key_mark, index_path(f.path, i)}));
-  return out;
-}
-
-Config read_config(const Ctx& ctx, const Field& f) {
-  const std::string& s = scalar_of(ctx, f, "1, 2, 3 or integrated");
-  if (s == "1") return Config::C1;
-  if (s == "2") return Config::C2;
-  if (s == "3") return Config::C3;
-  if (s == "integrated") return Config::Integrated;
-  ctx.fail(f.loc(), fmt::format("expected 1, 2, 3 or integrated, got '{}'", s));
-}
-
 // Helpers that assign a key's value when the key is present.
 template <typename T, typename Read>
 std::optional<Field> set_if(const MapView& m, std::string_view key, T& target, Read read) {
@@ -115,8 +87,6 @@ Loc key_loc(const Provenance& prov, const std::string& path) {
   if (auto it = prov.keys.find(path); it != prov.keys.end()) return it->second;
   return Loc{YAML::Mark::null_mark(), path + " (default)"};
 }
-
-Loc loc_of(const std::optional<Field>& f) { return f ? f->loc() : Loc{}; }
 
 // ---- Sections --------------------------------------------------------------------------------
 
@@ -155,82 +125,41 @@ void parse_uavs(const Ctx& ctx, const Field& f, std::vector<UavSpec>& uavs, Prov
   }
 }
 
-// A time window [from, to) of a phase or an outage: from >= 0 and to > from.
-void read_window(const Ctx& ctx, const Field& from, const Field& to, double& t_start, double& t_end) {
-  t_start = read_number(ctx, from, ge(0));
-  t_end = read_number(ctx, to);
-  if (!(t_end > t_start))
-    ctx.fail(to.loc(), fmt::format("must be greater than from ({}), got {}", t_start, to.node.Scalar()));
-}
-
-void parse_phases(const Ctx& ctx, const Field& f, std::vector<Phase>& phases, Provenance& prov) {
-  if (!f.node.IsSequence())
-    ctx.fail(f.loc(), fmt::format("expected a list of phases, got {}", describe(f.node)));
-  if (f.node.size() == 0) ctx.fail(f.loc(), "expected at least one phase");
-  phases.clear();
+// The phases as visit() reads them (sim/scenario.hpp), then what involves two of them: unique
+// names, sorted and not overlapping.
+void read_phases(const Ctx& ctx, const Field& f, std::vector<Phase>& phases, Provenance& prov) {
+  KeyLocations where;
+  settings_detail::Reader::read_list(ctx, f, phases, kPhaseList, &where);
   prov.phases_given = true;
   prov.phase_to.clear();
-  std::vector<Loc> name_locs;
-  for (std::size_t i = 0; i < f.node.size(); ++i) {
-    const Field item{f.node[i], f.key_mark, index_path(f.path, i)};
-    MapView m(ctx, item, {"name", "from", "to", "config", "add", "remove"});
-    Phase p;
-    p.name = fmt::format("phase{}", i + 1);
-    p.source = item.loc().path;
-    p.source_line = item.loc().mark.line + 1;
-    auto nf = m.get("name");
-    if (nf) p.name = read_string(ctx, *nf);
-    if (nf && !scenario_name_ok(p.name))
-      ctx.fail(nf->loc(), fmt::format("phase names must match [A-Za-z0-9_.-]+ and be at most {} characters, "
-                                      "got '{}'", kMaxNameLength, short_name(p.name)));
-    const Field from = m.require("from", item.loc());
-    const Field to = m.require("to", item.loc());
-    read_window(ctx, from, to, p.t_start, p.t_end);
-    p.config = read_config(ctx, m.require("config", item.loc()));
-    if (auto a = m.get("add")) p.add = read_sensor_list(ctx, *a);
-    if (auto r = m.get("remove")) {
-      p.remove = read_sensor_list(ctx, *r);
-      for (std::size_t k = 0; k < p.remove.size(); ++k) {
-        if (std::find(p.add.begin(), p.add.end(), p.remove[k]) != p.add.end())
-          ctx.fail(Field{r->node[k], r->key_mark, index_path(r->path, k)}.loc(),
-                   fmt::format("sensor '{}' is both added and removed", to_string(p.remove[k])));
-      }
-    }
-    const Loc name_loc = nf ? nf->loc() : item.loc();
-    for (std::size_t j = 0; j < phases.size(); ++j) {
+  auto at = [&](std::size_t i, const std::string& key) {
+    const std::string item = index_path(f.path, i);
+    const auto k = where.find(key.empty() ? item : child_path(item, key));
+    return k != where.end() ? k->second : where.at(item);
+  };
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    Phase& p = phases[i];
+    p.source = index_path(f.path, i);
+    p.source_line = at(i, "").mark.line + 1;
+    for (std::size_t j = 0; j < i; ++j)
       if (phases[j].name == p.name)
-        ctx.fail(name_loc, fmt::format("duplicate phase name '{}' (first at line {})", p.name,
-                                       name_locs[j].mark.line + 1));
-    }
-    if (!phases.empty() && p.t_start < phases.back().t_end - kTimeEps) {
-      ctx.fail(from.loc(),
-               fmt::format("phase '{}' starts at {}, before the previous phase '{}' ends ({}); "
-                           "phases must be sorted and must not overlap",
-                           p.name, p.t_start, phases.back().name, phases.back().t_end));
-    }
-    phases.push_back(std::move(p));
-    name_locs.push_back(name_loc);
-    prov.phase_to.push_back(to.loc());
+        ctx.fail(at(i, "name"), fmt::format("duplicate phase name '{}' (first at line {})", p.name,
+                                            at(j, "name").mark.line + 1));
+    if (i > 0 && p.t_start < phases[i - 1].t_end - kTimeEps)
+      ctx.fail(at(i, "from"), fmt::format("phase '{}' starts at {}, before the previous phase '{}' ends ({}); "
+                                          "phases must be sorted and must not overlap",
+                                          p.name, p.t_start, phases[i - 1].name, phases[i - 1].t_end));
+    prov.phase_to.push_back(at(i, "to"));
   }
 }
 
-void parse_outages(const Ctx& ctx, const Field& f, std::vector<Outage>& outages, Provenance& prov) {
-  if (!f.node.IsSequence())
-    ctx.fail(f.loc(), fmt::format("expected a list of outages, got {}", describe(f.node)));
-  outages.clear();
+void read_outages(const Ctx& ctx, const Field& f, std::vector<Outage>& outages, Provenance& prov) {
+  KeyLocations where;
+  settings_detail::Reader::read_list(ctx, f, outages, kOutageList, &where);
   prov.outage_agent.clear();
-  for (std::size_t i = 0; i < f.node.size(); ++i) {
-    const Field item{f.node[i], f.key_mark, index_path(f.path, i)};
-    MapView m(ctx, item, {"sensor", "from", "to", "agent"});
-    Outage o;
-    o.sensor = read_sensor(ctx, m.require("sensor", item.loc()));
-    const Field from = m.require("from", item.loc());
-    const Field to = m.require("to", item.loc());
-    read_window(ctx, from, to, o.t_start, o.t_end);
-    auto af = m.get("agent");
-    if (af) o.agent = read_string(ctx, *af);
-    outages.push_back(std::move(o));
-    prov.outage_agent.push_back(loc_of(af));
+  for (std::size_t i = 0; i < outages.size(); ++i) {
+    const auto k = where.find(child_path(index_path(f.path, i), "agent"));
+    prov.outage_agent.push_back(k != where.end() ? k->second : Loc{});
   }
 }
 
@@ -325,8 +254,8 @@ void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& pro
   if (auto f = m.get("duration")) prov.keys["duration"] = f->loc();
   if (auto f = m.get("noise")) read_settings(ctx, *f, s.noise);
   if (auto f = m.get("landmarks")) read_settings(ctx, *f, s.field, &prov.keys);
-  if (auto f = m.get("phases")) parse_phases(ctx, *f, s.phases, prov);
-  if (auto f = m.get("outages")) parse_outages(ctx, *f, s.outages, prov);
+  if (auto f = m.get("phases")) read_phases(ctx, *f, s.phases, prov);
+  if (auto f = m.get("outages")) read_outages(ctx, *f, s.outages, prov);
   if (auto f = m.get("control")) parse_control(ctx, *f, s.control, s.uavs, prov);
   for (std::string_view key : {"estimator", "control", "frontend"})
     if (auto f = m.get(key))
@@ -612,6 +541,22 @@ std::vector<Scenario> load_scenarios(const std::string& path) {
     throw ScenarioError(fmt::format("{}: holds a NUL byte at offset {}; a scenario file is YAML text", path,
                                     text.find('\0')));
   return parse_scenarios(text, path);
+}
+
+std::string window_problem(double from, double to) {
+  return to > from ? "" : fmt::format("must be greater than from ({}), got {}", from, to);
+}
+
+std::string phase_name_problem(const std::string& name) {
+  if (scenario_name_ok(name)) return "";
+  return fmt::format("phase names must match [A-Za-z0-9_.-]+ and be at most {} characters, got '{}'",
+                     kMaxNameLength, short_name(name));
+}
+
+int added_and_removed(const std::vector<Sensor>& add, const std::vector<Sensor>& remove) {
+  for (std::size_t k = 0; k < remove.size(); ++k)
+    if (std::find(add.begin(), add.end(), remove[k]) != add.end()) return static_cast<int>(k);
+  return -1;
 }
 
 }  // namespace wingman::sim

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <string_view>
@@ -16,6 +17,7 @@
 
 #include "geometry/camera.hpp"
 #include "geometry/settings.hpp"
+#include "sim/sensors.hpp"
 #include "sim/trajectory.hpp"
 #include "sim/yaml_input.hpp"
 
@@ -49,7 +51,21 @@ struct KeyLister {
   void pair(std::string_view key, int&, int&, geometry::Bounds = {}) { keys.push_back(key); }
   void check(std::string_view, bool, std::string_view) {}
   void other(std::string_view key) { keys.push_back(key); }
+  void required(std::string_view) {}
+  void optional(std::string_view key, std::string&) { keys.push_back(key); }
+  template <typename T>
+  void list(std::string_view key, std::vector<T>&, geometry::ListNames) { keys.push_back(key); }
 };
+
+// A list's item before it is read: T::list_item(i) where T has one (a default that depends on
+// the position), else T{}.
+template <typename T>
+T list_item(std::size_t i) {
+  if constexpr (requires { T::list_item(i); })
+    return T::list_item(i);
+  else
+    return T{};
+}
 
 int to_int_bound(double v, int fallback);
 
@@ -97,11 +113,44 @@ class Reader {
   }
   // A key of this map that another reader reads.
   void other(std::string_view) {}
-  // A condition on values already read: fails at `key` (or at the map when the key is absent).
+  // A condition on values already read: fails at `key`, or at item i of a list written
+  // `key[i]` (at the map when the key is absent).
   void check(std::string_view key, bool ok, std::string_view what) {
-    if (ok) return;
-    auto f = map_.get(key);
-    ctx_.fail(f ? f->loc() : Loc{map_loc_.mark, child_path(map_loc_.path, key)}, std::string(what));
+    if (!ok) ctx_.fail(key_loc(key), std::string(what));
+  }
+  void required(std::string_view key) {
+    if (!map_.get(key)) ctx_.fail(map_loc_, fmt::format("missing required key '{}'", key));
+  }
+  void optional(std::string_view key, std::string& x) { (*this)(key, x); }
+  void operator()(std::string_view key, Sensor& x) {
+    if (auto f = get(key)) x = read_sensor(ctx_, *f);
+  }
+  void operator()(std::string_view key, std::vector<Sensor>& x) {
+    if (auto f = get(key)) x = read_sensor_list(ctx_, *f);
+  }
+  void operator()(std::string_view key, Config& x) {
+    if (auto f = get(key)) x = read_config(ctx_, *f);
+  }
+  template <typename T>
+  void list(std::string_view key, std::vector<T>& items, geometry::ListNames names) {
+    if (auto f = get(key)) read_list(ctx_, *f, items, names, where_);
+  }
+  // Fills `items` from the list `f`, one map per item, each through T's visit().
+  template <typename T>
+  static void read_list(const Ctx& ctx, const Field& f, std::vector<T>& items, geometry::ListNames names,
+                        KeyLocations* where) {
+    if (!f.node.IsSequence())
+      ctx.fail(f.loc(), fmt::format("expected a list of {}, got {}", names.plural, describe(f.node)));
+    if (f.node.size() < names.min_items) ctx.fail(f.loc(), fmt::format("expected at least one {}", names.singular));
+    items.clear();
+    for (std::size_t i = 0; i < f.node.size(); ++i) {
+      const Field item{f.node[i], f.key_mark, index_path(f.path, i)};
+      if (where) (*where)[item.path] = item.loc();
+      T x = list_item<T>(i);
+      auto fn = [&](auto& v) { x.visit(v); };
+      read_map(ctx, item, fn, where);
+      items.push_back(std::move(x));
+    }
   }
   void operator()(std::string_view key, Eigen::Vector4d& x, geometry::Bounds b = {}) {
     if (auto f = get(key)) x = read_vec4(ctx_, *f, b);
@@ -158,6 +207,15 @@ class Reader {
     if (f && where_) (*where_)[f->path] = f->loc();
     return f;
   }
+  Loc key_loc(std::string_view key) const {
+    const std::size_t bracket = key.find('[');
+    const auto f = map_.get(key.substr(0, bracket));
+    if (!f) return Loc{map_loc_.mark, child_path(map_loc_.path, key)};
+    if (bracket == std::string_view::npos) return f->loc();
+    const std::size_t i = static_cast<std::size_t>(std::atol(std::string(key.substr(bracket + 1)).c_str()));
+    if (!f->node.IsSequence() || i >= f->node.size()) return f->loc();
+    return Field{f->node[i], f->key_mark, index_path(f->path, i)}.loc();
+  }
   const Ctx& ctx_;
   MapView map_;
   Loc map_loc_;
@@ -186,6 +244,29 @@ class Emitter {
   }
   void check(std::string_view, bool, std::string_view) {}
   void other(std::string_view) {}
+  void required(std::string_view) {}
+  void optional(std::string_view key, const std::string& x) {
+    if (!x.empty()) out_ << YAML::Key << std::string(key) << YAML::Value << x;
+  }
+  // A list of sensors is left out when empty (nothing added, nothing removed).
+  void operator()(std::string_view key, const std::vector<Sensor>& x) {
+    if (x.empty()) return;
+    out_ << YAML::Key << std::string(key) << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (Sensor s : x) out_ << to_string(s);
+    out_ << YAML::EndSeq;
+  }
+  // Each item as a flow map on a line of its own.
+  template <typename T>
+  void list(std::string_view key, const std::vector<T>& items, geometry::ListNames) {
+    out_ << YAML::Key << std::string(key) << YAML::Value << YAML::BeginSeq;
+    for (const T& item : items) {
+      T copy = item;
+      out_ << YAML::Flow << YAML::BeginMap;
+      copy.visit(*this);
+      out_ << YAML::EndMap;
+    }
+    out_ << YAML::EndSeq;
+  }
   void pair(std::string_view key, int a, int b, geometry::Bounds = {}) {
     out_ << YAML::Key << std::string(key) << YAML::Value << YAML::Flow << YAML::BeginSeq << a << b
          << YAML::EndSeq;
@@ -197,6 +278,8 @@ class Emitter {
   void put(int x) { out_ << x; }
   void put(bool x) { out_ << (x ? "true" : "false"); }
   void put(const std::string& x) { out_ << x; }
+  void put(Sensor s) { out_ << to_string(s); }
+  void put(Config c) { out_ << to_string(c); }
   // A derived value prints as the number with its origin as a comment, so that the file reruns
   // the same; one not yet derived prints as `auto`.
   void put(const geometry::AutoNumber& a) {

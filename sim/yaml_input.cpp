@@ -341,6 +341,37 @@ Waypoints read_waypoints(const Ctx& ctx, const Field& f) {
   return w;
 }
 
+namespace {
+const std::vector<std::string_view> kSensorNames = {"landmarks", "lead_projection", "altimeter",
+                                                    "range", "gps"};
+
+}  // namespace
+
+Sensor read_sensor(const Ctx& ctx, const Field& f) {
+  const std::string& s = scalar_of(ctx, f, "a sensor name");
+  if (auto k = sensor_from_string(s)) return *k;
+  ctx.fail(f.loc(), fmt::format("unknown sensor '{}'{}; expected one of {}", s,
+                                suggestion(s, kSensorNames), join(kSensorNames)));
+}
+
+std::vector<Sensor> read_sensor_list(const Ctx& ctx, const Field& f) {
+  if (!f.node.IsSequence())
+    ctx.fail(f.loc(), fmt::format("expected a list of sensor names, got {}", describe(f.node)));
+  std::vector<Sensor> out;
+  for (std::size_t i = 0; i < f.node.size(); ++i)
+    out.push_back(read_sensor(ctx, Field{f.node[i], f.key_mark, index_path(f.path, i)}));
+  return out;
+}
+
+Config read_config(const Ctx& ctx, const Field& f) {
+  const std::string& s = scalar_of(ctx, f, "1, 2, 3 or integrated");
+  if (s == "1") return Config::C1;
+  if (s == "2") return Config::C2;
+  if (s == "3") return Config::C3;
+  if (s == "integrated") return Config::Integrated;
+  ctx.fail(f.loc(), fmt::format("expected 1, 2, 3 or integrated, got '{}'", s));
+}
+
 }  // namespace wingman::sim
 
 namespace wingman::sim::settings_detail {

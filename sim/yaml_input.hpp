@@ -18,6 +18,7 @@
 
 #include "geometry/bounds_check.hpp"
 #include "geometry/camera.hpp"
+#include "sim/sensors.hpp"
 #include "geometry/settings.hpp"
 #include "sim/trajectory.hpp"
 
@@ -104,6 +105,10 @@ double read_number(const Ctx& ctx, const Field& f, Bounds b = any_value());
 long long read_integer(const Ctx& ctx, const Field& f, long long lo, long long hi);
 int read_int(const Ctx& ctx, const Field& f, int lo, int hi = std::numeric_limits<int>::max());
 std::uint64_t read_seed(const Ctx& ctx, const Field& f);
+// A sensor name, a list of them, a configuration (1, 2, 3 or integrated).
+Sensor read_sensor(const Ctx& ctx, const Field& f);
+std::vector<Sensor> read_sensor_list(const Ctx& ctx, const Field& f);
+Config read_config(const Ctx& ctx, const Field& f);
 // An integer seed or `per_run`.
 geometry::SeedSetting read_seed_setting(const Ctx& ctx, const Field& f);
 bool read_bool(const Ctx& ctx, const Field& f);

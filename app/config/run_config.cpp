@@ -200,32 +200,10 @@ std::vector<RunConfig> load_run_configs(const std::string& path) {
 
 namespace {
 
-std::vector<std::string> sensor_names(const std::vector<sim::Sensor>& v) {
-  std::vector<std::string> out;
-  for (sim::Sensor s : v) out.push_back(sim::to_string(s));
-  return out;
-}
-
 void emit_phases(YAML::Emitter& out, const RunConfig& cfg) {
-  out << YAML::Key << "phases" << YAML::Value << YAML::BeginSeq;
-  for (const auto& p : cfg.phases) {
-    out << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << p.name << YAML::Key << "from"
-        << YAML::Value << sim::number_text(p.t_start) << YAML::Key << "to" << YAML::Value
-        << sim::number_text(p.t_end) << YAML::Key << "config" << YAML::Value << sim::to_string(p.config);
-    if (!p.add.empty()) out << YAML::Key << "add" << YAML::Value << YAML::Flow << sensor_names(p.add);
-    if (!p.remove.empty()) out << YAML::Key << "remove" << YAML::Value << YAML::Flow << sensor_names(p.remove);
-    out << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
-  out << YAML::Key << "outages" << YAML::Value << YAML::BeginSeq;
-  for (const auto& o : cfg.outages) {
-    out << YAML::Flow << YAML::BeginMap << YAML::Key << "sensor" << YAML::Value << sim::to_string(o.sensor)
-        << YAML::Key << "from" << YAML::Value << sim::number_text(o.t_start) << YAML::Key << "to"
-        << YAML::Value << sim::number_text(o.t_end);
-    if (!o.agent.empty()) out << YAML::Key << "agent" << YAML::Value << o.agent;
-    out << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
+  sim::settings_detail::Emitter e(out);
+  e.list("phases", cfg.phases, sim::kPhaseList);
+  e.list("outages", cfg.outages, sim::kOutageList);
 }
 
 void emit_control(YAML::Emitter& out, const RunConfig& cfg) {
