@@ -55,7 +55,8 @@ class BoundsChecker {
   // What the scenario reader alone checks: conditions on the file's values, required keys.
   void check(std::string_view, bool, std::string_view) {}
   void required(std::string_view) {}
-  void optional(std::string_view, std::string&) {}
+  template <typename T>
+  void optional(std::string_view, T&) {}
   void other(std::string_view) {}
 
  private:

@@ -168,42 +168,6 @@ void read_outages(const Ctx& ctx, const Field& f, std::vector<Outage>& outages, 
 
 // A number for all four components of lambda = [lx, ly, lz, psi], or a list of four.
 
-void parse_control_uavs(const Ctx& ctx, const Field& f, std::vector<UavControlSpec>& out) {
-  if (!f.node.IsSequence() || f.node.size() == 0)
-    ctx.fail(f.loc(), fmt::format("expected a list of controlled UAVs, got {}", describe(f.node)));
-  out.clear();
-  std::vector<Loc> name_locs;
-  for (std::size_t i = 0; i < f.node.size(); ++i) {
-    const Field item{f.node[i], f.key_mark, index_path(f.path, i)};
-    MapView m(ctx, item, {"name", "initial_yaw", "lambda_d", "yaw_d"});
-    UavControlSpec u;
-    const Field nf = m.require("name", item.loc());
-    u.uav = read_string(ctx, nf);
-    for (std::size_t j = 0; j < out.size(); ++j)
-      if (out[j].uav == u.uav)
-        ctx.fail(nf.loc(), fmt::format("duplicate UAV '{}' (first at line {})", u.uav,
-                                       name_locs[j].mark.line + 1));
-    num(ctx, m, "initial_yaw", u.initial_yaw, in(-2 * M_PI, 2 * M_PI));
-    // The formation's offset from the lead: within the world's bounds (sim/budget.hpp).
-    set_if(m, "lambda_d", u.lambda_d, [&](const Field& x) {
-      return read_vec3(ctx, x, in(-RunLimits::kMaxCoordinate, RunLimits::kMaxCoordinate));
-    });
-    if (auto y = m.get("yaw_d")) {
-      if (y->node.IsScalar() && y->node.Scalar() == "lead_bearing")
-        u.yaw_d.reset();
-      else if (y->node.IsScalar() && !y->node.Scalar().empty() &&
-               (std::isdigit(static_cast<unsigned char>(y->node.Scalar()[0])) ||
-                std::string_view("+-.").find(y->node.Scalar()[0]) != std::string_view::npos))
-        u.yaw_d = read_number(ctx, *y, in(-2 * M_PI, 2 * M_PI));
-      else
-        ctx.fail(y->loc(), fmt::format("expected lead_bearing or a yaw in radians, got {}",
-                                       describe(y->node)));
-    }
-    out.push_back(std::move(u));
-    name_locs.push_back(nf.loc());
-  }
-}
-
 // The section's presence turns the closed loop on; every UAV of the scenario needs an entry
 // (default: section 7.3's uav1 and uav2).
 // Every controlled UAV is a UAV of the scenario and every UAV is controlled.
@@ -223,22 +187,23 @@ void check_control_uavs(const Ctx& ctx, const ControlSpec& c, const std::vector<
   }
 }
 
-void parse_control(const Ctx& ctx, const Field& f, ControlSpec& c, const std::vector<UavSpec>& uavs,
-                   Provenance& prov) {
+void read_control(const Ctx& ctx, const Field& f, ControlSpec& c, const std::vector<UavSpec>& uavs,
+                  Provenance& prov) {
   // The controller's keys (gains, switching, limits) are control::SlidingModeSettings', checked
-  // and read by app/ from settings_layers; these are the truth's and the evaluation's.
-  const MapView m = MapView::open(ctx, f);
+  // and read by app/ from settings_layers; ControlSpec's are the truth's and the evaluation's.
   c.enabled = true;
-  num(ctx, m, "settling_time", c.settling_time, ge(0));
-  if (auto df = m.get("disturbance")) {
-    MapView d(ctx, *df, {"bound", "seed"});
-    set_if(d, "bound", c.disturbance_bound, [&](const Field& x) { return read_vec4(ctx, x, ge(0)); });
-    if (auto s = d.get("seed")) c.disturbance_seed = read_seed(ctx, *s);
-  }
-  const auto uf = m.get("uavs");
-  if (uf) parse_control_uavs(ctx, *uf, c.uavs);
-  else if (c.uavs.empty()) c.uavs = paper_control_uavs();
-  prov.control_uavs = uf ? uf->loc() : f.key_loc();
+  KeyLocations where;
+  read_settings_open(ctx, f, c, &where);
+  const std::string list = child_path(f.path, "uavs");
+  const auto given = where.find(list);
+  if (given == where.end() && c.uavs.empty()) c.uavs = paper_control_uavs();
+  prov.control_uavs = given != where.end() ? given->second : f.key_loc();
+  for (std::size_t i = 0; i < c.uavs.size() && given != where.end(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (c.uavs[j].uav == c.uavs[i].uav)
+        ctx.fail(where.at(child_path(index_path(list, i), "name")),
+                 fmt::format("duplicate UAV '{}' (first at line {})", c.uavs[i].uav,
+                             where.at(child_path(index_path(list, j), "name")).mark.line + 1));
   check_control_uavs(ctx, c, uavs, prov.control_uavs);
 }
 
@@ -256,7 +221,7 @@ void apply_common(const Ctx& ctx, const MapView& m, Scenario& s, Provenance& pro
   if (auto f = m.get("landmarks")) read_settings(ctx, *f, s.field, &prov.keys);
   if (auto f = m.get("phases")) read_phases(ctx, *f, s.phases, prov);
   if (auto f = m.get("outages")) read_outages(ctx, *f, s.outages, prov);
-  if (auto f = m.get("control")) parse_control(ctx, *f, s.control, s.uavs, prov);
+  if (auto f = m.get("control")) read_control(ctx, *f, s.control, s.uavs, prov);
   for (std::string_view key : {"estimator", "control", "frontend"})
     if (auto f = m.get(key))
       s.settings_layers.push_back(std::make_shared<const SettingsLayer>(SettingsLayer{std::string(key), ctx, *f}));

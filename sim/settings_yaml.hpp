@@ -8,15 +8,19 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "geometry/camera.hpp"
 #include "geometry/settings.hpp"
+#include "sim/control_spec.hpp"
 #include "sim/sensors.hpp"
 #include "sim/trajectory.hpp"
 #include "sim/yaml_input.hpp"
@@ -52,7 +56,8 @@ struct KeyLister {
   void check(std::string_view, bool, std::string_view) {}
   void other(std::string_view key) { keys.push_back(key); }
   void required(std::string_view) {}
-  void optional(std::string_view key, std::string&) { keys.push_back(key); }
+  template <typename T>
+  void optional(std::string_view key, T&) { keys.push_back(key); }
   template <typename T>
   void list(std::string_view key, std::vector<T>&, geometry::ListNames) { keys.push_back(key); }
 };
@@ -69,11 +74,16 @@ T list_item(std::size_t i) {
 
 int to_int_bound(double v, int fallback);
 
+// A map whose other keys another reader checks (the control: section's, sim's and app's).
+struct OpenMap {};
+
 // Second pass: reads the keys present in the map.
 class Reader {
  public:
   Reader(const Ctx& ctx, const Field& f, std::vector<std::string_view> keys, KeyLocations* where)
       : ctx_(ctx), map_(ctx, f, std::move(keys)), map_loc_(f.loc()), where_(where) {}
+  Reader(const Ctx& ctx, const Field& f, KeyLocations* where, OpenMap)
+      : ctx_(ctx), map_(MapView::open(ctx, f)), map_loc_(f.loc()), where_(where) {}
 
   void operator()(std::string_view key, double& x, geometry::Bounds b = {}) {
     if (auto f = get(key)) x = read_number(ctx_, *f, b);
@@ -122,6 +132,21 @@ class Reader {
     if (!map_.get(key)) ctx_.fail(map_loc_, fmt::format("missing required key '{}'", key));
   }
   void optional(std::string_view key, std::string& x) { (*this)(key, x); }
+  void optional(std::string_view key, std::optional<std::uint64_t>& x) {
+    if (auto f = get(key)) x = read_seed(ctx_, *f);
+  }
+  void operator()(std::string_view key, YawSetpoint& x, geometry::Bounds b = {}) {
+    auto f = get(key);
+    if (!f) return;
+    const bool scalar = f->node.IsScalar() && !f->node.Scalar().empty();
+    const std::string s = scalar ? f->node.Scalar() : std::string();
+    if (s == "lead_bearing")
+      x.yaw.reset();
+    else if (scalar && (std::isdigit(static_cast<unsigned char>(s[0])) || std::string_view("+-.").find(s[0]) != std::string_view::npos))
+      x.yaw = read_number(ctx_, *f, b);
+    else
+      ctx_.fail(f->loc(), fmt::format("expected lead_bearing or a yaw in radians, got {}", describe(f->node)));
+  }
   void operator()(std::string_view key, Sensor& x) {
     if (auto f = get(key)) x = read_sensor(ctx_, *f);
   }
@@ -248,6 +273,9 @@ class Emitter {
   void optional(std::string_view key, const std::string& x) {
     if (!x.empty()) out_ << YAML::Key << std::string(key) << YAML::Value << x;
   }
+  void optional(std::string_view key, const std::optional<std::uint64_t>& x) {
+    if (x) out_ << YAML::Key << std::string(key) << YAML::Value << *x;
+  }
   // A list of sensors is left out when empty (nothing added, nothing removed).
   void operator()(std::string_view key, const std::vector<Sensor>& x) {
     if (x.empty()) return;
@@ -279,6 +307,7 @@ class Emitter {
   void put(bool x) { out_ << (x ? "true" : "false"); }
   void put(const std::string& x) { out_ << x; }
   void put(Sensor s) { out_ << to_string(s); }
+  void put(const YawSetpoint& y) { out_ << (y.yaw ? number_text(*y.yaw) : std::string("lead_bearing")); }
   void put(Config c) { out_ << to_string(c); }
   // A derived value prints as the number with its origin as a comment, so that the file reruns
   // the same; one not yet derived prints as `auto`.
@@ -317,6 +346,13 @@ template <typename S>
 void read_settings(const Ctx& ctx, const Field& f, S& settings, KeyLocations* where = nullptr) {
   auto fn = [&](auto& v) { settings.visit(v); };
   settings_detail::Reader::read_map(ctx, f, fn, where);
+}
+
+// The same for a map whose other keys another reader checks.
+template <typename S>
+void read_settings_open(const Ctx& ctx, const Field& f, S& settings, KeyLocations* where = nullptr) {
+  settings_detail::Reader r(ctx, f, where, settings_detail::OpenMap{});
+  settings.visit(r);
 }
 
 // Writes `settings` as the value of `key` in the map being emitted.

@@ -17,13 +17,15 @@ namespace wingman::app {
 
 namespace {
 
-// The controller's settings, with sim's keys of the same map accepted and left to sim.
+// The controller's settings, with sim's keys of the same map (read by sim into the scenario)
+// read here into a copy nobody keeps, so that every key of the section is known to one reader.
 struct ControlSection {
   control::SlidingModeSettings& settings;
+  sim::ControlSpec sims{};
   template <class V>
   void visit(V& v) {
     settings.visit(v);
-    for (std::string_view key : sim::ControlSpec::kKeys) v.other(key);
+    sims.visit(v);
   }
 };
 
@@ -206,28 +208,19 @@ void emit_phases(YAML::Emitter& out, const RunConfig& cfg) {
   e.list("outages", cfg.outages, sim::kOutageList);
 }
 
-void emit_control(YAML::Emitter& out, const RunConfig& cfg) {
-  if (!cfg.closed_loop()) return;
-  const auto& c = cfg.control;
-  out << YAML::Key << "control" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "settling_time" << YAML::Value << sim::number_text(c.settling_time);
-  out << YAML::Key << "disturbance" << YAML::Value << YAML::BeginMap << YAML::Key << "bound" << YAML::Value;
-  sim::emit_numbers(out, c.disturbance_bound);
-  if (c.disturbance_seed) out << YAML::Key << "seed" << YAML::Value << *c.disturbance_seed;
-  out << YAML::EndMap << YAML::Key << "uavs" << YAML::Value << YAML::BeginSeq;
-  for (const auto& u : c.uavs) {
-    out << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << u.uav;
-    out << YAML::Key << "initial_yaw" << YAML::Value << sim::number_text(u.initial_yaw);
-    out << YAML::Key << "lambda_d" << YAML::Value;
-    sim::emit_numbers(out, u.lambda_d);
-    out << YAML::Key << "yaw_d" << YAML::Value << (u.yaw_d ? sim::number_text(*u.yaw_d) : "lead_bearing");
-    out << YAML::EndMap;
+// The control: section: sim's keys, then the controller's.
+struct ControlOut {
+  sim::ControlSpec spec;
+  control::SlidingModeSettings controller;
+  template <class V>
+  void visit(V& v) {
+    spec.visit(v);
+    controller.visit(v);
   }
-  out << YAML::EndSeq;
-  control::SlidingModeSettings controller = cfg.controller;
-  sim::settings_detail::Emitter e(out);
-  controller.visit(e);
-  out << YAML::EndMap;
+};
+
+void emit_control(YAML::Emitter& out, const RunConfig& cfg) {
+  if (cfg.closed_loop()) sim::emit_settings(out, "control", ControlOut{cfg.control, cfg.controller});
 }
 
 }  // namespace

@@ -412,6 +412,14 @@ phases:
               HasSubstr("scn.yaml:2:5: phases[0]: missing required key 'from'"));
   EXPECT_THAT(error_of("phases:\n  - {from: 0, to: 40, config: 1, add: [gps], remove: [gps]}\n"),
               HasSubstr("phases[0].remove[0]: sensor 'gps' is both added and removed"));
+  // The keys of a phase, an outage and the control section are their visit()'s: a misspelt one
+  // is named with the closest.
+  EXPECT_THAT(error_of("phases:\n  - {from: 0, to: 40, confg: 1}\n"),
+              HasSubstr("phases[0].confg: unknown key 'confg' (did you mean 'config'?)"));
+  EXPECT_THAT(error_of("outages:\n  - {sensor: gps, from: 1, to: 2, agnet: lead}\n"),
+              HasSubstr("outages[0].agnet: unknown key 'agnet' (did you mean 'agent'?)"));
+  EXPECT_THAT(error_of("control:\n  disturbance: {bund: [0, 0, 0, 0]}\n"),
+              HasSubstr("control.disturbance.bund: unknown key 'bund' (did you mean 'bound'?)"));
   // Gaps are allowed.
   EXPECT_NO_THROW(parse_scenarios(
       "phases:\n  - {from: 0, to: 10, config: 1}\n  - {from: 20, to: 30, config: 2}\n", "x.yaml"));
