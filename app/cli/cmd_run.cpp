@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "app/cli/cli_options.hpp"
+#include "app/cli/results_layout.hpp"
 #include "app/pipeline/pipeline.hpp"
 #include "io/progress.hpp"
 #include "io/version.hpp"
@@ -69,7 +70,6 @@ int run_command(const RunOptions& o) {
   std::optional<io::ResultsDir> staged;
   stage_output(staged, out, "results", o.force);
   io::ResultsDir& results = *staged;
-  const bool nested = scenarios.size() > 1 || !scenarios.front().variant.empty();
 
   std::vector<std::string> dirs, labels;
   for (const auto& scn : scenarios) {
@@ -97,13 +97,8 @@ int run_command(const RunOptions& o) {
     }
     progress.finish();
 
-    const fs::path dir = nested ? results.staging() / scn.variant : results.staging();
-    fs::create_directories(dir);
-    const eval::Metrics metrics = eval::compute_metrics(rec);
-    eval::write_results(metrics, rec, dir);
-    write_config(scn, dir / "config.yaml");
-    if (!o.no_plots) eval::write_plots(rec, dir);
-    if (!o.quiet) fmt::print("{}\n", eval::format_summary(metrics, rec));
+    const fs::path dir = variant_dir(results, scn, scenarios.size() > 1);
+    write_variant(rec, scn, dir, !o.no_plots, o.quiet);
     dirs.push_back(dir.string());
     labels.push_back(scn.variant.empty() ? scn.name : scn.variant);
   }
@@ -118,9 +113,7 @@ int run_command(const RunOptions& o) {
       }
     }
   }
-  copy_scenario(scenarios.front(), results.staging());
-  results.commit();
-  if (!o.quiet) fmt::print("results: {}\n", out.string());
+  publish_results(results, scenarios.front(), out, o.quiet);
   return 0;
 }
 

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "app/cli/cli_options.hpp"
+#include "app/cli/results_layout.hpp"
 #include "app/pipeline/pipeline.hpp"
 #include "io/progress.hpp"
 #include "app/pipeline/replay.hpp"
@@ -53,12 +54,7 @@ void replay_variant(const SlamOptions& o, const Replay& replay, const fs::path& 
     throw io::UsageError(e.what());
   }
   progress.finish();
-  fs::create_directories(dir);
-  const eval::Metrics metrics = eval::compute_metrics(rec);
-  eval::write_results(metrics, rec, dir);
-  write_config(scn, dir / "config.yaml");
-  if (!o.no_plots) eval::write_plots(rec, dir);
-  if (!o.quiet) fmt::print("{}\n", eval::format_summary(metrics, rec));
+  write_variant(rec, scn, dir, !o.no_plots, o.quiet);
 }
 
 // Every variant asked for (or the dataset's own) into one results directory laid out as
@@ -75,13 +71,8 @@ int slam_command(const SlamOptions& o) {
   const fs::path out = o.out.empty() ? fs::path("results") / (first.name + "_replay") : fs::path(o.out);
   std::optional<io::ResultsDir> staged;
   stage_output(staged, out, "results", o.force);
-  for (const Replay& r : replays) {
-    const bool nested = replays.size() > 1 || !r.scenario.variant.empty();
-    replay_variant(o, r, nested ? staged->staging() / r.scenario.variant : staged->staging());
-  }
-  copy_scenario(first, staged->staging());
-  staged->commit();
-  if (!o.quiet) fmt::print("results: {}\n", out.string());
+  for (const Replay& r : replays) replay_variant(o, r, variant_dir(*staged, r.scenario, replays.size() > 1));
+  publish_results(*staged, first, out, o.quiet);
   return 0;
 }
 

@@ -106,6 +106,14 @@ fs::path known_submission(const fs::path& ds_dir, const fs::path& tmp, const std
 
 nlohmann::json read_json(const fs::path& p) { return nlohmann::json::parse(read_file(p)); }
 
+// score-matches of the submission `sub` on pairs.csv into a fresh `out`.
+RunResult score_into(const fs::path& ds_dir, const fs::path& tmp, const fs::path& sub, const fs::path& out) {
+  fs::remove_all(out);
+  return run_wingman({"score-matches", ds_dir.string(), sub.string(), "--pairs", (tmp / "pairs.csv").string(),
+                      "--out", out.string(), "--no-plots", "-q"},
+                     tmp);
+}
+
 // A group's figure at a threshold of scores.json.
 double at(const nlohmann::json& group, std::size_t threshold, const char* what) {
   return group.at("thresholds").at(threshold).at(what).get<double>();
@@ -130,10 +138,7 @@ TEST_F(ScoreMatchesCli, PairsListsTemporalAndCrossPairsWithBaselines) {
 TEST_F(ScoreMatchesCli, HandMadeMatchesScoreExactPrecisionAndRecall) {
   const fs::path sub = known_submission(ds(), tmp(), "known");
   const fs::path out = tmp() / "known_scores";
-  fs::remove_all(out);
-  const RunResult r = run_wingman({"score-matches", ds().string(), sub.string(), "--pairs",
-                                   (tmp() / "pairs.csv").string(), "--out", out.string(), "--no-plots", "-q"},
-                                  tmp());
+  const RunResult r = score_into(ds(), tmp(), sub, out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("known"));
   const auto j = read_json(out / "scores.json");
@@ -295,19 +300,13 @@ TEST_F(ScoreMatchesCli, AFrontendsTimingsFileGivesItsMsPerFrame) {
   const fs::path sub = known_submission(ds(), tmp(), "timed");
   write_file(sub / "timings.csv", "agent,t_ns,ms\nuav1,0,10\nuav1,500000000,20\nuav2,0,30\nuav2,100000000,99\n");
   const fs::path out = tmp() / "timed_scores";
-  fs::remove_all(out);
-  const RunResult r = run_wingman({"score-matches", ds().string(), sub.string(), "--pairs",
-                                   (tmp() / "pairs.csv").string(), "--out", out.string(), "--no-plots", "-q"},
-                                  tmp());
+  const RunResult r = score_into(ds(), tmp(), sub, out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // The three frames the two pairs use: (10 + 20 + 30) / 3.
   EXPECT_DOUBLE_EQ(read_json(out / "scores.json").at("methods").at(0).at("detect_ms_per_frame").get<double>(), 20.0);
 
   write_file(sub / "timings.csv", "agent,t_ns,ms\nuav1,0,10\n");
-  fs::remove_all(out);
-  const RunResult missing = run_wingman({"score-matches", ds().string(), sub.string(), "--pairs",
-                                         (tmp() / "pairs.csv").string(), "--out", out.string(), "--no-plots", "-q"},
-                                        tmp());
+  const RunResult missing = score_into(ds(), tmp(), sub, out);
   EXPECT_EQ(missing.exit_code, 2) << missing.output;
   EXPECT_THAT(missing.output, HasSubstr("timings.csv: no time for frame"));
   EXPECT_FALSE(fs::exists(out));
