@@ -58,6 +58,22 @@ struct CameraInfo {
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();     // camera minus body position
   double rate = 10;
   int channels = 3;  // 3: RGB colour, 1: gray
+  // The shutter (sim/camera_sensor.hpp), written to cam0/sensor.yaml with each row's time.
+  bool rolling = false;
+  double exposure_s = 0;
+  double line_delay_s = 0;
+  bool top_to_bottom = true;
+  // A physical sensor's parameters (key, value), in cam0/sensor.yaml's `sensor:`; empty: ideal.
+  std::vector<std::pair<std::string, double>> sensor;
+  // Whether the frames carry an exposure time (cam0/exposure.csv is written).
+  bool exposed() const { return exposure_s > 0 || !sensor.empty(); }
+};
+
+// cam0/exposure.csv: what a frame was taken with (the shutter's, or auto-exposure's, time and gain).
+struct ExposureSample {
+  std::int64_t t_ns = 0;
+  double exposure_s = 0;
+  double gain = 1;
 };
 
 // A body pose (state_groundtruth_estimate0: p_WB, q = R_WB, velocity in the world frame and the
@@ -110,6 +126,7 @@ struct AgentData {
   std::vector<ImuSample> imu;
   std::vector<Vec3Sample> gps;
   std::vector<ScalarSample> altimeter, range, ahrs;
+  std::vector<ExposureSample> exposure;  // cameras with an exposure time
 };
 
 struct Dataset {
@@ -156,6 +173,7 @@ class DatasetWriter {
                    const cv::Mat& depth);
   void ground_truth(const std::string& agent, const PoseSample& s);
   void camera_pose(const std::string& agent, const PoseSample& s);
+  void exposure(const std::string& agent, const ExposureSample& s);
   void gps(const std::string& agent, const Vec3Sample& s);
   void altimeter(const std::string& agent, const ScalarSample& s);
   void range(const std::string& agent, const ScalarSample& s);

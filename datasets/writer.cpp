@@ -202,6 +202,7 @@ void DatasetWriter::gps(const std::string& agent, const Vec3Sample& s) { get(age
 void DatasetWriter::altimeter(const std::string& agent, const ScalarSample& s) { get(agent).altimeter.push_back(s); }
 void DatasetWriter::range(const std::string& agent, const ScalarSample& s) { get(agent).range.push_back(s); }
 void DatasetWriter::ahrs(const std::string& agent, const ScalarSample& s) { get(agent).ahrs.push_back(s); }
+void DatasetWriter::exposure(const std::string& agent, const ExposureSample& s) { get(agent).exposure.push_back(s); }
 void DatasetWriter::imu_info(const std::string& agent, const ImuInfo& info) { get(agent).imu_info = info; }
 void DatasetWriter::imu(const std::string& agent, const ImuSample& s) { get(agent).imu.push_back(s); }
 
@@ -235,6 +236,24 @@ void emit_sensor_head(YAML::Emitter& e, const char* type, const std::string& com
   emit_T_BS(e, R_BS, p_BS);
 }
 
+// The shutter, with what a loader needs for each row's time and pose; the sensor when it is physical.
+void emit_shutter(YAML::Emitter& e, const CameraInfo& c) {
+  e << YAML::Key << "shutter" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "type" << YAML::Value << (c.rolling ? "rolling" : "global");
+  e << YAML::Key << "exposure_s" << YAML::Value << c.exposure_s;
+  e << YAML::Key << "line_delay_s" << YAML::Value << (c.rolling ? c.line_delay_s : 0.0);
+  e << YAML::Key << "readout" << YAML::Value << (c.top_to_bottom ? "top_to_bottom" : "bottom_to_top");
+  e << YAML::Key << "row_time" << YAML::Value
+    << "a frame's time stamp is the middle of the exposure of row (h - 1) / 2; row r's is that plus "
+       "(r - (h - 1) / 2) * line_delay_s (top_to_bottom) or minus it (bottom_to_top); its pose is the "
+       "camera's then (cam0_pose0 holds the middle row's)";
+  e << YAML::EndMap;
+  if (c.sensor.empty()) return;
+  e << YAML::Key << "sensor" << YAML::Value << YAML::BeginMap;
+  for (const auto& [k, v] : c.sensor) e << YAML::Key << k << YAML::Value << v;
+  e << YAML::EndMap;
+}
+
 // cam0 or depth0: the camera's nominal mount (T_BS: the commanded attitude at body yaw 0, the
 // offset d) and its intrinsics. Radial-tangential takes four coefficients; a lens with k3 is
 // written as ROS's plumb_bob (k1, k2, p1, p2, k3).
@@ -256,6 +275,7 @@ void write_camera_yaml(const fs::path& p, const CameraInfo& c, bool depth) {
   e << YAML::Key << "distortion_model" << YAML::Value << (radtan ? "radial-tangential" : "plumb_bob");
   e << YAML::Key << "distortion_coefficients" << YAML::Value;
   seq(e, radtan ? std::vector<double>{k.k1, k.k2, k.p1, k.p2} : std::vector<double>{k.k1, k.k2, k.p1, k.p2, k.k3});
+  emit_shutter(e, c);
   if (depth) {
     e << YAML::Key << "depth_scale" << YAML::Value << kDepthScale;
     e << YAML::Key << "encoding" << YAML::Value << "mono16";
@@ -348,6 +368,12 @@ void write_frames(const fs::path& mav0, const AgentData& a) {
     write_csv(mav0 / s / "data.csv", kFramesHeader, a.frames.size(),
               [&](std::size_t i) { return fmt::format("{},{}.png", a.frames[i], a.frames[i]); });
   write_camera_yaml(mav0 / "cam0" / "sensor.yaml", *a.camera, false);
+  if (a.camera->exposed())
+    write_csv(mav0 / "cam0" / "exposure.csv", "#timestamp [ns],exposure [s],gain", a.exposure.size(),
+              [&](std::size_t i) {
+                const auto& x = a.exposure[i];
+                return fmt::format("{},{},{}", x.t_ns, g(x.exposure_s), g(x.gain));
+              });
   write_camera_yaml(mav0 / "depth0" / "sensor.yaml", *a.camera, true);
 }
 

@@ -565,48 +565,76 @@ struct Renderer::Undistort {
   cv::Mat nearest_x, nearest_y;  // float maps for depth (nearest)
 };
 
+const Renderer::Undistort& Renderer::undistort(const geometry::PinholeCamera& cam) {
+  const auto& d = cam.distortion();
+  const auto key = std::make_tuple(cam.fx(), cam.fy(), cam.cx(), cam.cy(), cam.width(),
+                                   cam.height(), d.k1, d.k2, d.p1, d.p2, d.k3);
+  auto& u = undistort_[key];
+  if (u) return *u;
+  u = std::make_shared<Undistort>();
+  cv::Mat mx(cam.height(), cam.width(), CV_32F), my(cam.height(), cam.width(), CV_32F);
+  double umin = 0, umax = cam.width() - 1, vmin = 0, vmax = cam.height() - 1;
+  for (int r = 0; r < cam.height(); ++r)
+    for (int c = 0; c < cam.width(); ++c) {
+      const Eigen::Vector2d xn = cam.unproject_normalised(Eigen::Vector2d(c, r));
+      const double pu = cam.fx() * xn.x() + cam.cx(), pv = cam.fy() * xn.y() + cam.cy();
+      mx.at<float>(r, c) = static_cast<float>(pu);
+      my.at<float>(r, c) = static_cast<float>(pv);
+      umin = std::min(umin, pu), umax = std::max(umax, pu);
+      vmin = std::min(vmin, pv), vmax = std::max(vmax, pv);
+    }
+  // Canvas covering every pixel the distorted image samples (at most 3x the image).
+  umin = std::max(std::floor(umin) - 2, -1.0 * cam.width());
+  vmin = std::max(std::floor(vmin) - 2, -1.0 * cam.height());
+  umax = std::min(std::ceil(umax) + 2, 2.0 * cam.width());
+  vmax = std::min(std::ceil(vmax) + 2, 2.0 * cam.height());
+  u->w = static_cast<int>(umax - umin) + 1;
+  u->h = static_cast<int>(vmax - vmin) + 1;
+  u->cx = cam.cx() - umin;
+  u->cy = cam.cy() - vmin;
+  mx -= static_cast<float>(umin);
+  my -= static_cast<float>(vmin);
+  u->nearest_x = mx;
+  u->nearest_y = my;
+  cv::convertMaps(mx, my, u->map1, u->map2, CV_16SC2);
+  return *u;
+}
+
 Frame Renderer::render(const CameraView& view, const std::optional<LeadPose>& lead) {
   const auto& cam = view.camera;
   if (cam.distortion().is_zero())
     return render_pinhole(cam.fx(), cam.fy(), cam.cx(), cam.cy(), cam.width(), cam.height(), view,
                           lead);
-  const auto& d = cam.distortion();
-  const auto key = std::make_tuple(cam.fx(), cam.fy(), cam.cx(), cam.cy(), cam.width(),
-                                   cam.height(), d.k1, d.k2, d.p1, d.p2, d.k3);
-  auto& u = undistort_[key];
-  if (!u) {
-    u = std::make_shared<Undistort>();
-    cv::Mat mx(cam.height(), cam.width(), CV_32F), my(cam.height(), cam.width(), CV_32F);
-    double umin = 0, umax = cam.width() - 1, vmin = 0, vmax = cam.height() - 1;
-    for (int r = 0; r < cam.height(); ++r)
-      for (int c = 0; c < cam.width(); ++c) {
-        const Eigen::Vector2d xn = cam.unproject_normalised(Eigen::Vector2d(c, r));
-        const double pu = cam.fx() * xn.x() + cam.cx(), pv = cam.fy() * xn.y() + cam.cy();
-        mx.at<float>(r, c) = static_cast<float>(pu);
-        my.at<float>(r, c) = static_cast<float>(pv);
-        umin = std::min(umin, pu), umax = std::max(umax, pu);
-        vmin = std::min(vmin, pv), vmax = std::max(vmax, pv);
-      }
-    // Canvas covering every pixel the distorted image samples (at most 3x the image).
-    umin = std::max(std::floor(umin) - 2, -1.0 * cam.width());
-    vmin = std::max(std::floor(vmin) - 2, -1.0 * cam.height());
-    umax = std::min(std::ceil(umax) + 2, 2.0 * cam.width());
-    vmax = std::min(std::ceil(vmax) + 2, 2.0 * cam.height());
-    u->w = static_cast<int>(umax - umin) + 1;
-    u->h = static_cast<int>(vmax - vmin) + 1;
-    u->cx = cam.cx() - umin;
-    u->cy = cam.cy() - vmin;
-    mx -= static_cast<float>(umin);
-    my -= static_cast<float>(vmin);
-    u->nearest_x = mx;
-    u->nearest_y = my;
-    cv::convertMaps(mx, my, u->map1, u->map2, CV_16SC2);
-  }
-  const Frame wide = render_pinhole(cam.fx(), cam.fy(), u->cx, u->cy, u->w, u->h, view, lead);
+  const Undistort& u = undistort(cam);
+  const Frame wide = render_pinhole(cam.fx(), cam.fy(), u.cx, u.cy, u.w, u.h, view, lead);
   Frame f;
-  cv::remap(wide.rgb, f.rgb, u->map1, u->map2, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-  cv::remap(wide.depth, f.depth, u->nearest_x, u->nearest_y, cv::INTER_NEAREST,
+  cv::remap(wide.rgb, f.rgb, u.map1, u.map2, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::remap(wide.depth, f.depth, u.nearest_x, u.nearest_y, cv::INTER_NEAREST,
             cv::BORDER_CONSTANT);
+  return f;
+}
+
+Frame Renderer::render_rows(const CameraView& view, const std::optional<LeadPose>& lead, int row0, int rows) {
+  const auto& cam = view.camera;
+  if (row0 < 0 || rows < 1 || row0 + rows > cam.height())
+    throw std::invalid_argument("render_rows: rows " + std::to_string(row0) + " + " + std::to_string(rows) +
+                                " outside an image of " + std::to_string(cam.height()));
+  // The band is an image of its own whose principal point sits row0 rows higher.
+  if (cam.distortion().is_zero())
+    return render_pinhole(cam.fx(), cam.fy(), cam.cx(), cam.cy() - row0, cam.width(), rows, view, lead);
+  const Undistort& u = undistort(cam);
+  const cv::Range band(row0, row0 + rows);
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(u.nearest_y.rowRange(band), &lo, &hi);
+  const int y0 = std::max(0, static_cast<int>(std::floor(lo)) - 1);
+  const int y1 = std::min(u.h - 1, static_cast<int>(std::ceil(hi)) + 1);
+  const Frame wide = render_pinhole(cam.fx(), cam.fy(), u.cx, u.cy - y0, u.w, y1 - y0 + 1, view, lead);
+  const cv::Mat mx = u.nearest_x.rowRange(band), my = u.nearest_y.rowRange(band) - static_cast<float>(y0);
+  cv::Mat m1, m2;
+  cv::convertMaps(mx, my, m1, m2, CV_16SC2);
+  Frame f;
+  cv::remap(wide.rgb, f.rgb, m1, m2, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::remap(wide.depth, f.depth, mx, my, cv::INTER_NEAREST, cv::BORDER_CONSTANT);
   return f;
 }
 

@@ -43,6 +43,9 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   Frame render(const CameraView& view, const std::optional<LeadPose>& lead = std::nullopt);
+  // Rows [row0, row0 + rows) of that image, and only they are drawn (a rolling shutter's band):
+  // the same pixels as render()'s rows.
+  Frame render_rows(const CameraView& view, const std::optional<LeadPose>& lead, int row0, int rows);
   const GlContext& context() const { return ctx_; }
 
   // The OpenGL projection matrix for an undistorted w x h image with these intrinsics
@@ -54,6 +57,7 @@ class Renderer {
  private:
   struct Impl;
   struct Undistort;
+  const Undistort& undistort(const geometry::PinholeCamera& cam);
   Frame render_pinhole(double fx, double fy, double cx, double cy, int w, int h,
                        const CameraView& view, const std::optional<LeadPose>& lead);
   GlContext& ctx_;

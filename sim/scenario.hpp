@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -16,6 +17,7 @@
 
 #include "geometry/camera.hpp"
 #include "geometry/settings.hpp"
+#include "sim/camera_sensor.hpp"
 #include "sim/control_spec.hpp"
 #include "sim/sensors.hpp"
 #include "sim/trajectory.hpp"
@@ -89,6 +91,8 @@ struct CameraSpec {
   int width = 1000, height = 1000;
   geometry::Distortion distortion{};
   Eigen::Vector3d offset{0, 0, 0};  // d of eq. 59: camera position minus UAV position, world frame
+  ShutterSpec shutter{};
+  SensorSpec sensor{};
 
   template <class V>
   void visit(V& v) {
@@ -100,6 +104,17 @@ struct CameraSpec {
     v("height", height, geometry::in(1, 16384));
     v("distortion", distortion);  // k1 k2 p1 p2 [k3]
     v("offset", offset);
+    v.section("shutter", [&](auto& x) { shutter.visit(x); });
+    v.section("sensor", [&](auto& x) { sensor.visit(x); });
+    v.check("sensor", !sensor.physical() || shutter.exposure > 0 || sensor.auto_exposure.enabled,
+            "a physical sensor needs shutter.exposure above 0 or auto_exposure.enabled");
+  }
+  // s from the first row's exposure start to the last row's end: what must fit in a frame interval.
+  double frame_time() const {
+    const double exposure = sensor.physical() && sensor.auto_exposure.enabled
+                                ? std::max(shutter.exposure, sensor.auto_exposure.max_exposure)
+                                : shutter.exposure;
+    return exposure + (shutter.rolling() ? shutter.line_delay * (height - 1) : 0);
   }
   geometry::PinholeCamera camera() const {
     return geometry::PinholeCamera(fx, fy, cx, cy, width, height, distortion);

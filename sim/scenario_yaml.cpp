@@ -282,6 +282,22 @@ void check_budget(const Ctx& ctx, const Scenario& s, const Provenance& prov) {
                          duration_text(e.seconds), steps, duration_text(L::kMaxSeconds)));
 }
 
+// A camera's exposure and readout fit in its frame interval (sim/camera_sensor.hpp).
+void check_cameras(const Ctx& ctx, const Scenario& s, const Provenance& prov) {
+  for (std::size_t i = 0; i < s.uavs.size(); ++i) {
+    const CameraSpec& c = s.uavs[i].camera;
+    if (c.frame_time() <= s.dt()) continue;
+    const std::string cam = fmt::format("uavs[{}].camera.", i);
+    const bool auto_max = c.sensor.physical() && c.sensor.auto_exposure.enabled &&
+                          c.sensor.auto_exposure.max_exposure > c.shutter.exposure;
+    const std::string key = auto_max ? cam + "sensor.auto_exposure.max_exposure"
+                            : c.shutter.exposure > 0 ? cam + "shutter.exposure" : cam + "shutter.line_delay";
+    ctx.fail(key_loc(prov, key),
+             fmt::format("exposure and readout take {:.4g} s, longer than the frame interval {:.4g} s "
+                         "(rate {} Hz)", c.frame_time(), s.dt(), s.rate));
+  }
+}
+
 // The spline of a `waypoints` or `file` trajectory; its start is the lead's initial position
 // unless the scenario sets one.
 void build_lead_path(const Ctx& ctx, Scenario& s, const Provenance& prov) {
@@ -352,6 +368,7 @@ void finalise(const Ctx& ctx, Scenario& s, const Provenance& prov) {
                            s.uav_names()));
   }
   check_budget(ctx, s, prov);
+  check_cameras(ctx, s, prov);
 }
 
 std::vector<UavSpec> paper_uavs() {

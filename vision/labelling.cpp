@@ -28,21 +28,22 @@ std::optional<double> sample_depth(const cv::Mat& depth, const Eigen::Vector2d& 
 }
 
 std::optional<Eigen::Vector3d> back_project(const Eigen::Vector2d& uv, const geometry::PinholeCamera& cam,
-                                            const CameraPose& true_pose, const cv::Mat& depth) {
+                                            const geometry::FramePoses& true_pose, const cv::Mat& depth) {
   const auto z = sample_depth(depth, uv);
   if (!z) return std::nullopt;
   const Eigen::Vector2d xn = cam.unproject_normalised(uv);
   const Eigen::Vector3d p_C(xn.x() * *z, xn.y() * *z, *z);
-  return true_pose.R_CW.transpose() * p_C + true_pose.position;
+  const CameraPose pose = true_pose.at_row(uv.y());
+  return pose.R_CW.transpose() * p_C + pose.position;
 }
 
 LabelResult label_landmark_observation(const Eigen::Vector3d& point_W, const Eigen::Vector2d& observed_uv,
-                                       const geometry::PinholeCamera& cam, const CameraPose& true_pose,
+                                       const geometry::PinholeCamera& cam, const geometry::FramePoses& true_pose,
                                        const cv::Mat& depth, const LabelSettings& cfg) {
   cfg.validate();
   LabelResult r;
   r.reprojection_px = std::numeric_limits<double>::infinity();
-  const Eigen::Vector3d p_C = true_pose.to_camera(point_W);
+  const Eigen::Vector3d p_C = true_pose.to_camera(cam, point_W);
   const auto uv = cam.project(p_C);
   if (!uv) {
     r.reason = "behind camera";
@@ -73,9 +74,9 @@ LabelResult label_landmark_observation(const Eigen::Vector3d& point_W, const Eig
 }
 
 LabelResult label_pixel_pair(const Eigen::Vector2d& uv_a, const geometry::PinholeCamera& cam_a,
-                             const CameraPose& true_pose_a, const cv::Mat& depth_a,
+                             const geometry::FramePoses& true_pose_a, const cv::Mat& depth_a,
                              const Eigen::Vector2d& uv_b, const geometry::PinholeCamera& cam_b,
-                             const CameraPose& true_pose_b, const cv::Mat& depth_b,
+                             const geometry::FramePoses& true_pose_b, const cv::Mat& depth_b,
                              const LabelSettings& cfg) {
   if (depth_a.empty())
     throw std::invalid_argument("label_pixel_pair: camera a's depth image is needed to back-project");

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "geometry/camera.hpp"
+#include "geometry/frame_poses.hpp"
 #include "vision/cross_match.hpp"
 
 namespace wingman::vision {
@@ -37,23 +38,24 @@ struct LabelResult {
 // surface". An empty Mat skips the depth test.
 std::optional<double> sample_depth(const cv::Mat& depth, const Eigen::Vector2d& uv);
 
-// World point through a pixel: its ray scaled to the rendered depth there, with the true pose.
+// World point through a pixel: its ray scaled to the rendered depth there, with the true pose (of
+// the pixel's row, under a rolling shutter).
 // This is also the ground truth of a landmark in rendered mode (docs/design.md, evaluation).
 std::optional<Eigen::Vector3d> back_project(const Eigen::Vector2d& uv, const geometry::PinholeCamera& cam,
-                                            const CameraPose& true_pose, const cv::Mat& depth);
+                                            const geometry::FramePoses& true_pose, const cv::Mat& depth);
 
 // A landmark correspondence: the landmark's true point seen at `observed_uv` by a camera at its
-// true pose.
+// true pose (under a rolling shutter, that of the row the point is drawn on).
 LabelResult label_landmark_observation(const Eigen::Vector3d& point_W, const Eigen::Vector2d& observed_uv,
-                                       const geometry::PinholeCamera& cam, const CameraPose& true_pose,
+                                       const geometry::PinholeCamera& cam, const geometry::FramePoses& true_pose,
                                        const cv::Mat& depth, const LabelSettings& settings = {});
 
 // A cross-camera pixel pair: a's pixel is back-projected through a's depth and then labelled in b
 // as a landmark observation at uv_b.
 LabelResult label_pixel_pair(const Eigen::Vector2d& uv_a, const geometry::PinholeCamera& cam_a,
-                             const CameraPose& true_pose_a, const cv::Mat& depth_a,
+                             const geometry::FramePoses& true_pose_a, const cv::Mat& depth_a,
                              const Eigen::Vector2d& uv_b, const geometry::PinholeCamera& cam_b,
-                             const CameraPose& true_pose_b, const cv::Mat& depth_b,
+                             const geometry::FramePoses& true_pose_b, const cv::Mat& depth_b,
                              const LabelSettings& settings = {});
 
 }  // namespace wingman::vision

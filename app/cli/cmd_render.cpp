@@ -22,7 +22,7 @@
 #include "datasets/dataset.hpp"
 #include "io/results_dir.hpp"
 #include "geometry/rotation.hpp"
-#include "render/effects.hpp"
+#include "app/pipeline/camera_imaging.hpp"
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene.hpp"
@@ -154,7 +154,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
   for (const auto& u : scn.uavs) info.agents.push_back(u.name);
   datasets::DatasetWriter writer(staged->staging(), info);
   writer.add_agent("lead", std::nullopt);
-  std::vector<render::ImageEffects> effects;
+  std::vector<app::CameraImaging> imaging;
   for (const auto& u : scn.uavs) {
     datasets::CameraInfo c;
     c.camera = u.camera.camera();
@@ -162,8 +162,9 @@ int render_command(const RenderOptions& o, const std::string& variant) {
     c.offset = u.camera.offset;
     c.rate = scn.rate;
     c.channels = channels;
+    describe_shutter(u.camera, c);
     writer.add_agent(u.name, c);
-    effects.emplace_back(scn.world.image, scn.seed, u.name);
+    imaging.emplace_back(scn, static_cast<int>(imaging.size()));
   }
 
   const int cams = static_cast<int>(scn.uavs.size());
@@ -180,13 +181,15 @@ int render_command(const RenderOptions& o, const std::string& variant) {
     writer.ground_truth("lead", pose(t_ns, lk.position, geometry::rot_z(heading), lk.velocity));
     if (scn.lead.gps) writer.gps("lead", {t_ns, sensors.gps(t)});
     for (int j = 0; j < cams; ++j) {
-      const Eigen::Matrix3d R_CW = truth.camera_R_CW(j, t);
       const auto& u = scn.uavs[j];
-      const Eigen::Vector3d x_c = truth.camera(j, t).position;
-      render::Frame f = renderer.render({u.camera.camera(), R_CW, x_c}, lead);
-      effects[j].apply(f);
-      writer.write_frame(u.name, t_ns, f.rgb, f.depth);
-      writer.camera_pose(u.name, pose(t_ns, x_c, R_CW));
+      app::TakenFrame f = imaging[j].take(truth, t, [&](const render::CameraView& view, const render::LeadPose& l,
+                                                        int row0, int rows) {
+        return rows == view.camera.height() ? renderer.render(view, l) : renderer.render_rows(view, l, row0, rows);
+      });
+      const geometry::CameraPose& centre = f.poses.centre();
+      writer.write_frame(u.name, t_ns, f.frame.rgb, f.frame.depth);
+      writer.camera_pose(u.name, pose(t_ns, centre.position, centre.R_CW));
+      writer.exposure(u.name, {t_ns, f.exposure.exposure_s, f.exposure.gain});
       if (u.altimeter) writer.altimeter(u.name, {t_ns, sensors.altimeter(j, t)});
       if (u.range) writer.range(u.name, {t_ns, sensors.range(j, t)});
       writer.ahrs(u.name, {t_ns, ahrs_noise(ahrs_rng)});

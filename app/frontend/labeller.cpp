@@ -48,7 +48,7 @@ std::optional<Eigen::Vector2d> GroundTruthLabeller::lead(const std::optional<Eig
   // In view when the reference point projects inside the image with room for the marker and the
   // rendered depth there is the lead's.
   ++fr.frames;
-  const Eigen::Vector3d p_true = f.true_pose.to_camera(lead_W);
+  const Eigen::Vector3d p_true = f.true_pose.to_camera(model, lead_W);
   const auto uv_true = model.project(p_true);
   bool in_view = false;
   if (uv_true && model.in_image(*uv_true, 15)) {

@@ -12,15 +12,16 @@
 
 #include "eval/metrics/run_record.hpp"
 #include "geometry/camera.hpp"
+#include "geometry/frame_poses.hpp"
 #include "geometry/pose.hpp"
 #include "render/renderer.hpp"
 
 namespace wingman::app {
 
-// A frame with the true pose it was taken from.
+// A frame with the true pose it was taken from (one per row under a rolling shutter).
 struct CameraFrame {
   render::Frame frame;
-  geometry::CameraPose true_pose;
+  geometry::FramePoses true_pose;
 };
 
 class GroundTruthLabeller {

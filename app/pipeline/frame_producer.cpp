@@ -32,41 +32,38 @@ RendererFrames::RendererFrames(const RunConfig& cfg, std::vector<int> cam_uav, r
     renderer_ = std::make_unique<render::Renderer>(*ctx_, *scene_);
     scene_.reset();
   }
-  for (int u : cam_uav_) {
-    models_.push_back(cfg.uavs[u].camera.camera());
-    effects_.push_back(std::make_unique<render::ImageEffects>(cfg.world.image, cfg.seed, cfg.uavs[u].name));
-  }
+  for (int u : cam_uav_) imaging_.push_back(std::make_unique<CameraImaging>(cfg, u));
 }
 
 RendererFrames::~RendererFrames() = default;
 
 std::string RendererFrames::description() const { return ctx_->description(); }
 
-render::Frame RendererFrames::render(const render::CameraView& view, const render::LeadPose& lead) {
+render::Frame RendererFrames::render(const render::CameraView& view, const render::LeadPose& lead, int row0,
+                                     int rows) {
   if (!renderer_) {  // the first frame the cache did not hold
     renderer_ = std::make_unique<render::Renderer>(*ctx_, *scene_);
     scene_.reset();
   }
-  return renderer_->render(view, lead);
+  if (row0 == 0 && rows == view.camera.height()) return renderer_->render(view, lead);
+  return renderer_->render_rows(view, lead, row0, rows);
 }
 
 void RendererFrames::produce(int cam, int, double t, CameraFrame& out) {
-  const int u = cam_uav_[cam];
-  const render::LeadPose lead = sim::lead_pose(truth_, t, cfg_.world);
-  out.true_pose = {truth_.camera_R_CW(u, t), truth_.camera(u, t).position};
-  const render::CameraView view{models_[cam], out.true_pose};
-  if (!cache_) {
-    out.frame = render(view, lead);
-  } else {
+  CameraImaging& imaging = *imaging_[cam];
+  // The cache holds instants: an exposure or a rolling shutter renders every time.
+  const bool cached = cache_ && imaging.instant();
+  TakenFrame f = imaging.take(truth_, t, [&](const render::CameraView& view, const render::LeadPose& lead,
+                                              int row0, int rows) {
+    if (!cached) return render(view, lead, row0, rows);
     const render::FrameKey key = keyer_->key(view, lead);
-    if (auto cached = cache_->load(key)) {
-      out.frame = std::move(*cached);
-    } else {
-      out.frame = render(view, lead);
-      cache_->store(key, out.frame);
-    }
-  }
-  effects_[cam]->apply(out.frame);
+    if (auto hit = cache_->load(key)) return std::move(*hit);
+    render::Frame frame = render(view, lead, row0, rows);
+    cache_->store(key, frame);
+    return frame;
+  });
+  out.frame = std::move(f.frame);
+  out.true_pose = std::move(f.poses);
 }
 
 void RendererFrames::finish(eval::FrontendRecord& rec) const {
@@ -83,7 +80,7 @@ DatasetFrames::DatasetFrames(const datasets::Dataset& ds, std::vector<const data
 void DatasetFrames::produce(int cam, int k, double t, CameraFrame& out) {
   const int u = cam_uav_[cam];
   const datasets::AgentData& a = *agents_[cam];
-  out.true_pose = {truth_.camera_R_CW(u, t), truth_.camera(u, t).position};
+  out.true_pose = true_poses(truth_.scenario(), truth_, u, t);
   cv::Mat img = ds_.load_image(a.name, a.frames[k]);
   if (img.channels() == 1) cv::cvtColor(img, img, cv::COLOR_GRAY2RGB);
   out.frame.rgb = img;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/frontend/labeller.hpp"
+#include "app/pipeline/camera_imaging.hpp"
 #include "app/config/run_config.hpp"
 #include "eval/metrics/run_record.hpp"
 #include "render/gl_context.hpp"
@@ -20,7 +21,6 @@ struct AgentData;
 }  // namespace wingman::datasets
 
 namespace wingman::render {
-class ImageEffects;
 class Renderer;
 class FrameCache;
 class FrameKeyer;
@@ -52,8 +52,9 @@ struct FrameCacheOptions {
 
 // Renders each filter camera (UAV cam_uav[j]) with an OpenGL context of `backend`; throws
 // std::invalid_argument naming the scenario for a broken world, render::GlError when no context.
-// With a frame cache, a frame the cache holds is read back instead of rendered (the image effects
-// are applied either way), and the scene is uploaded to the context only when a frame misses.
+// With a frame cache, a frame the cache holds is read back instead of rendered (the sensor and the
+// image effects are applied either way; a frame with an exposure time or a rolling shutter is
+// always rendered), and the scene is uploaded to the context only when a frame misses.
 class RendererFrames final : public FrameProducer {
  public:
   RendererFrames(const RunConfig& cfg, std::vector<int> cam_uav, render::GlBackend backend,
@@ -65,16 +66,15 @@ class RendererFrames final : public FrameProducer {
   void finish(eval::FrontendRecord& rec) const override;
 
  private:
-  render::Frame render(const render::CameraView& view, const render::LeadPose& lead);
+  render::Frame render(const render::CameraView& view, const render::LeadPose& lead, int row0, int rows);
 
   const RunConfig& cfg_;
   std::vector<int> cam_uav_;
   const sim::Truth& truth_;
-  std::vector<geometry::PinholeCamera> models_;
   std::unique_ptr<render::Scene> scene_;  // until the renderer is made
   std::unique_ptr<render::GlContext> ctx_;
   std::unique_ptr<render::Renderer> renderer_;
-  std::vector<std::unique_ptr<render::ImageEffects>> effects_;
+  std::vector<std::unique_ptr<CameraImaging>> imaging_;
   std::unique_ptr<render::FrameKeyer> keyer_;
   std::unique_ptr<render::FrameCache> cache_;
 };

@@ -15,42 +15,9 @@ namespace wingman::render {
 namespace {
 
 using testing::backend_name;
-
-// A horizontal square of side s at p, unlit, in colour c.
-Mesh square(const Eigen::Vector3d& p, double s, const Eigen::Vector3d& c, int material) {
-  Mesh m;
-  m.material = material;
-  const double h = s / 2;
-  m.add(p + Eigen::Vector3d(-h, -h, 0), {0, 0, 1}, {0, 0}, c);
-  m.add(p + Eigen::Vector3d(h, -h, 0), {0, 0, 1}, {1, 0}, c);
-  m.add(p + Eigen::Vector3d(h, h, 0), {0, 0, 1}, {1, 1}, c);
-  m.add(p + Eigen::Vector3d(-h, h, 0), {0, 0, 1}, {0, 1}, c);
-  m.indices = {0, 1, 2, 0, 2, 3};
-  return m;
-}
-
-Scene target_scene(const std::vector<Eigen::Vector3d>& targets, double side) {
-  Scene s;
-  Material unlit;
-  unlit.unlit = true;
-  s.materials.push_back(unlit);
-  s.static_meshes.push_back(square({0, 0, 0}, 400, {0, 0, 0}, 0));  // dark ground
-  for (const auto& t : targets) s.static_meshes.push_back(square(t, side, {1, 1, 1}, 0));
-  s.sky = {0, 0, 0};
-  s.msaa = 4;
-  return s;
-}
-
-// Intensity-weighted centroid of the bright blob around a pixel.
-Eigen::Vector2d centroid(const cv::Mat& gray, const Eigen::Vector2d& near, int radius) {
-  double sw = 0, su = 0, sv = 0;
-  for (int r = std::max(0, int(near.y()) - radius); r <= std::min(gray.rows - 1, int(near.y()) + radius); ++r)
-    for (int c = std::max(0, int(near.x()) - radius); c <= std::min(gray.cols - 1, int(near.x()) + radius); ++c) {
-      const double w = gray.at<uchar>(r, c);
-      sw += w, su += w * c, sv += w * r;
-    }
-  return {su / sw, sv / sw};
-}
+using testing::centroid;
+using testing::square;
+using testing::target_scene;
 
 class RendererTest : public ::testing::TestWithParam<GlBackend> {};
 

@@ -1,0 +1,58 @@
+// One UAV camera's imaging chain, shared by the SLAM loop's renderer and `wingman render`: the
+// shutter (exposure blur, rolling shutter; render/shutter.hpp) over the true motion, the sensor
+// (noise, response, auto-exposure; render/sensor.hpp) and the world's image effects. It returns
+// the frame with the poses it was taken from (one per row under a rolling shutter), so that
+// labels and datasets follow the effects exactly.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "datasets/dataset.hpp"
+#include "geometry/frame_poses.hpp"
+#include "render/effects.hpp"
+#include "render/renderer.hpp"
+#include "render/sensor.hpp"
+#include "sim/scenario.hpp"
+#include "sim/truth.hpp"
+
+namespace wingman::app {
+
+struct TakenFrame {
+  render::Frame frame;
+  geometry::FramePoses poses;
+  render::Exposure exposure;
+};
+
+// The poses camera `uav`'s frame at time t is taken from: the camera's state at t carried on at
+// constant acceleration over the readout (a fraction of a step), the gimbal's own rotation.
+geometry::FramePoses true_poses(const sim::Scenario& scn, const sim::Truth& truth, int uav, double t);
+
+// The shutter and sensor a dataset's cam0/sensor.yaml records.
+void describe_shutter(const sim::CameraSpec& camera, datasets::CameraInfo& info);
+
+class CameraImaging {
+ public:
+  // Draws rows [row0, row0 + rows) of the camera's image of the scene seen from `view` with the
+  // lead at `lead` (a whole frame when rows is the image's height).
+  using Draw = std::function<render::Frame(const render::CameraView& view, const render::LeadPose& lead,
+                                           int row0, int rows)>;
+
+  CameraImaging(const sim::Scenario& scn, int uav);
+  // Camera `uav`'s frame at time t, drawn over the exposure and readout with the motion of
+  // true_poses() and the lead's own.
+  TakenFrame take(const sim::Truth& truth, double t, const Draw& draw);
+  // A global shutter with no exposure time: one render at the frame's time, the same for every
+  // run of a seed-free truth (a frame cache may hold it).
+  bool instant() const;
+
+ private:
+  const sim::Scenario& scn_;
+  int uav_;
+  geometry::PinholeCamera model_;
+  render::SensorModel sensor_;
+  render::ImageEffects effects_;
+};
+
+}  // namespace wingman::app

@@ -1,0 +1,105 @@
+#include "render/sensor.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "sim/rng.hpp"
+
+namespace wingman::render {
+namespace {
+
+constexpr double kRenderedGamma = 2.2;  // how the renderer's 8-bit image encodes radiance
+constexpr double kPoissonBelow = 30;    // e-: exact Poisson below, its normal limit above
+
+double dn_max(const sim::SensorSpec& s) { return std::ldexp(1.0, s.bits) - 1; }
+
+}  // namespace
+
+SensorModel::SensorModel(const sim::SensorSpec& sensor, double exposure_s, const geometry::PinholeCamera& cam,
+                         std::uint64_t seed, const std::string& camera)
+    : spec_(sensor), rng_(sim::make_stream(seed, "sensor/" + camera)) {
+  next_.exposure_s = exposure_s;
+  next_.gain = spec_.gain;
+  if (!physical()) return;
+  const auto& ae = spec_.auto_exposure;
+  if (next_.exposure_s <= 0) next_.exposure_s = spec_.reference_exposure;
+  if (ae.enabled) next_.exposure_s = std::clamp(next_.exposure_s, ae.min_exposure, ae.max_exposure);
+  // The fixed pattern: drawn once per camera, the same in every frame.
+  std::mt19937_64 fixed = sim::make_stream(seed, "sensor_pattern/" + camera);
+  std::normal_distribution<double> n01(0, 1);
+  pixel_gain_.create(cam.height(), cam.width(), CV_32F);
+  dark_offset_.create(cam.height(), cam.width(), CV_32F);
+  for (int r = 0; r < cam.height(); ++r)
+    for (int c = 0; c < cam.width(); ++c) {
+      const Eigen::Vector2d xn = cam.unproject_normalised(Eigen::Vector2d(c, r));
+      const double cos2 = 1 / (1 + xn.squaredNorm());
+      const double vignette = 1 - spec_.vignetting * (1 - cos2 * cos2);
+      pixel_gain_.at<float>(r, c) = static_cast<float>(vignette * std::max(0.0, 1 + spec_.prnu * n01(fixed)));
+      dark_offset_.at<float>(r, c) = static_cast<float>(spec_.dsnu * n01(fixed));
+    }
+}
+
+double SensorModel::electrons(double linear, double pixel_gain, const Exposure& e) const {
+  return linear * pixel_gain * spec_.full_well * (e.exposure_s / spec_.reference_exposure) +
+         spec_.dark_current * e.exposure_s;
+}
+
+double SensorModel::mean_dn(double linear, double pixel_gain, const Exposure& e) const {
+  return e.gain * dn_max(spec_) / spec_.full_well * electrons(linear, pixel_gain, e);
+}
+
+double SensorModel::variance_dn(double linear, double pixel_gain, const Exposure& e) const {
+  const double k = e.gain * dn_max(spec_) / spec_.full_well;
+  return k * k * (electrons(linear, pixel_gain, e) + spec_.read_noise * spec_.read_noise);
+}
+
+Exposure SensorModel::apply(Frame& f) {
+  const Exposure used = next_;
+  if (!physical()) return used;
+  const double top = dn_max(spec_), k = used.gain * top / spec_.full_well;
+  std::vector<float> to_linear(256);
+  for (int i = 0; i < 256; ++i) to_linear[i] = static_cast<float>(std::pow(i / 255.0, kRenderedGamma));
+  std::vector<std::uint8_t> to_output(static_cast<std::size_t>(top) + 1);
+  for (std::size_t d = 0; d < to_output.size(); ++d)
+    to_output[d] = cv::saturate_cast<std::uint8_t>(255 * std::pow(d / top, 1 / spec_.gamma));
+  cv::Mat shot(f.rgb.size(), CV_32FC3), read(f.rgb.size(), CV_32FC3);
+  cv::RNG noise(rng_());
+  noise.fill(shot, cv::RNG::NORMAL, 0, 1);
+  noise.fill(read, cv::RNG::NORMAL, 0, spec_.read_noise);
+  const double ratio = spec_.full_well * used.exposure_s / spec_.reference_exposure;
+  const double dark = spec_.dark_current * used.exposure_s;
+  for (int r = 0; r < f.rgb.rows; ++r) {
+    auto* px = f.rgb.ptr<std::uint8_t>(r);
+    const auto* zs = shot.ptr<float>(r);
+    const auto* zr = read.ptr<float>(r);
+    const auto* g = pixel_gain_.ptr<float>(r);
+    const auto* d = dark_offset_.ptr<float>(r);
+    for (int i = 0; i < f.rgb.cols * 3; ++i) {
+      const double mean = std::max(0.0, to_linear[px[i]] * g[i / 3] * ratio + dark + d[i / 3]);
+      double e = mean < kPoissonBelow ? static_cast<double>(std::poisson_distribution<int>(mean)(rng_))
+                                      : mean + std::sqrt(mean) * zs[i];
+      e += zr[i];
+      const double dn = std::clamp(std::round(e * k), 0.0, top);
+      px[i] = to_output[static_cast<std::size_t>(dn)];
+    }
+  }
+  update_auto_exposure(f.rgb);
+  return used;
+}
+
+void SensorModel::update_auto_exposure(const cv::Mat& rgb) {
+  const auto& ae = spec_.auto_exposure;
+  if (!ae.enabled) return;
+  cv::Mat grey;
+  cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+  const double m = std::max(1e-3, cv::mean(grey)[0] / 255.0);
+  // The output's grey is signal^(1/gamma): the signal must change by (target/m)^gamma.
+  const double total = next_.exposure_s * next_.gain * std::pow(ae.target / m, spec_.gamma * ae.rate);
+  next_.exposure_s = std::clamp(total / spec_.gain, ae.min_exposure, ae.max_exposure);
+  next_.gain = std::clamp(total / next_.exposure_s, spec_.gain, ae.max_gain);
+}
+
+}  // namespace wingman::render
