@@ -19,6 +19,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 
+#include "app/pipeline/camera_imaging.hpp"
 #include "bench/process_cpu.hpp"
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
@@ -209,6 +210,51 @@ void quality_sweep(benchmark::State& state, render::GlBackend backend) {
   state.counters["worst_over_median"] = ms.back() / ms[ms.size() / 2];
   state.SetLabel(renderer.context().description());
 }
+
+// The camera effects (sim/camera_sensor.hpp) on one 1000 x 1000 camera of
+// scenes/paper_rendered_fast.yaml (MSAA 1, anisotropy 1) at t = 20 s, through the imaging chain
+// the runs use (app/pipeline/camera_imaging.hpp). Argument: 0 ideal, 1 exposure blur (9 images),
+// 2 rolling shutter exact (every row its own pose), 3 rolling shutter in bands of 10 rows,
+// 4 physical sensor with auto-exposure, 5 all of them (bands of 10, 5 images, physical sensor).
+void set_camera_effect(sim::CameraSpec& c, int effect) {
+  using S = sim::ShutterSpec;
+  if (effect == 1 || effect == 5) c.shutter.exposure = 0.01, c.shutter.subframes = effect == 1 ? 9 : 5;
+  if (effect == 2 || effect == 3 || effect == 5) {
+    c.shutter.type = S::Type::Rolling;
+    c.shutter.line_delay = 3e-5;
+    c.shutter.rows_per_band = effect == 2 ? 1 : 10;
+  }
+  if (effect == 4 || effect == 5) {
+    c.sensor.model = sim::SensorSpec::Model::Physical;
+    c.sensor.auto_exposure.enabled = true;
+    c.sensor.vignetting = 0.5;
+    if (effect == 4) c.shutter.subframes = 1;  // the sensor alone: no blur
+  }
+}
+
+void camera_effect(benchmark::State& state, render::GlBackend backend) {
+  sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_rendered_fast.yaml").front();
+  set_camera_effect(scn.uavs[0].camera, static_cast<int>(state.range(0)));
+  const auto ctx = context_or_skip(state, backend);
+  if (!ctx) return;
+  render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
+  const sim::OpenLoopTruth truth(scn);
+  app::CameraImaging imaging(scn, 0);
+  auto draw = [&](const render::CameraView& v, const render::LeadPose& l, int row0, int rows) {
+    return rows == v.camera.height() ? renderer.render(v, l) : renderer.render_rows(v, l, row0, rows);
+  };
+  imaging.take(truth, 20.0, draw);  // warm-up
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) {
+    app::TakenFrame f = imaging.take(truth, 20.0, draw);
+    benchmark::DoNotOptimize(f.frame.rgb.data);
+  }
+  state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
+  state.SetLabel(renderer.context().description());
+}
+
+void BM_CameraEffectEgl(benchmark::State& s) { camera_effect(s, render::GlBackend::Egl); }
+BENCHMARK(BM_CameraEffectEgl)->DenseRange(0, 5)->ArgName("effect")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_QualitySweepEgl(benchmark::State& s) { quality_sweep(s, render::GlBackend::Egl); }
 // Arguments as BM_RenderEgl's. One iteration: 24 frames per setting.

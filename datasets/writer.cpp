@@ -240,7 +240,8 @@ void emit_sensor_head(YAML::Emitter& e, const char* type, const std::string& com
 void emit_shutter(YAML::Emitter& e, const CameraInfo& c) {
   e << YAML::Key << "shutter" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "type" << YAML::Value << (c.rolling ? "rolling" : "global");
-  e << YAML::Key << "exposure_s" << YAML::Value << c.exposure_s;
+  e << YAML::Key << "exposure_s" << YAML::Value << c.exposure_s;  // the first frame's
+  if (c.exposed()) e << YAML::Key << "exposure_per_frame" << YAML::Value << "exposure.csv";
   e << YAML::Key << "line_delay_s" << YAML::Value << (c.rolling ? c.line_delay_s : 0.0);
   e << YAML::Key << "readout" << YAML::Value << (c.top_to_bottom ? "top_to_bottom" : "bottom_to_top");
   e << YAML::Key << "row_time" << YAML::Value

@@ -21,12 +21,9 @@ double dn_max(const sim::SensorSpec& s) { return std::ldexp(1.0, s.bits) - 1; }
 SensorModel::SensorModel(const sim::SensorSpec& sensor, double exposure_s, const geometry::PinholeCamera& cam,
                          std::uint64_t seed, const std::string& camera)
     : spec_(sensor), rng_(sim::make_stream(seed, "sensor/" + camera)) {
-  next_.exposure_s = exposure_s;
+  next_.exposure_s = spec_.initial_exposure(exposure_s);
   next_.gain = spec_.gain;
   if (!physical()) return;
-  const auto& ae = spec_.auto_exposure;
-  if (next_.exposure_s <= 0) next_.exposure_s = spec_.reference_exposure;
-  if (ae.enabled) next_.exposure_s = std::clamp(next_.exposure_s, ae.min_exposure, ae.max_exposure);
   // The fixed pattern: drawn once per camera, the same in every frame.
   std::mt19937_64 fixed = sim::make_stream(seed, "sensor_pattern/" + camera);
   std::normal_distribution<double> n01(0, 1);

@@ -25,6 +25,7 @@ struct Exposure {
 
 class SensorModel {
  public:
+  // exposure_s: the shutter's (sim::SensorSpec::initial_exposure).
   SensorModel(const sim::SensorSpec& sensor, double exposure_s, const geometry::PinholeCamera& cam,
               std::uint64_t seed, const std::string& camera);
   bool physical() const { return spec_.physical(); }

@@ -4,6 +4,8 @@
 // frames (render/shutter.hpp, render/sensor.hpp).
 #pragma once
 
+#include <algorithm>
+
 #include "geometry/settings.hpp"
 
 namespace wingman::sim {
@@ -100,6 +102,13 @@ struct SensorSpec {
     v.section("auto_exposure", [&](auto& x) { auto_exposure.visit(x); });
   }
   bool physical() const { return model == Model::Physical; }
+  // The first frame's exposure: the shutter's (the reference exposure when that is 0), within
+  // auto-exposure's range; the ideal sensor keeps the shutter's.
+  double initial_exposure(double shutter_exposure) const {
+    if (!physical()) return shutter_exposure;
+    const double e = shutter_exposure > 0 ? shutter_exposure : reference_exposure;
+    return auto_exposure.enabled ? std::clamp(e, auto_exposure.min_exposure, auto_exposure.max_exposure) : e;
+  }
 };
 
 }  // namespace wingman::sim

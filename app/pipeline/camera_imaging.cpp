@@ -30,7 +30,7 @@ geometry::FramePoses true_poses(const sim::Scenario& scn, const sim::Truth& trut
 void describe_shutter(const sim::CameraSpec& camera, datasets::CameraInfo& info) {
   const sim::ShutterSpec& s = camera.shutter;
   info.rolling = s.rolling();
-  info.exposure_s = s.exposure;
+  info.exposure_s = camera.sensor.initial_exposure(s.exposure);
   info.line_delay_s = s.line_delay;
   info.top_to_bottom = s.readout == sim::ShutterSpec::Readout::TopToBottom;
   info.sensor.clear();

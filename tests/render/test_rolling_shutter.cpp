@@ -51,7 +51,7 @@ TEST_P(RollingShutterTest, TargetsLandOnTheirRowsPoseProjection) {
                                        << " on " << ctx.description();
     worst_global = std::max(worst_global, (got - *global).norm());
   }
-  EXPECT_GT(worst_global, 2.0);  // the effect is there
+  EXPECT_GT(worst_global, 2.5);  // the effect is there (3.1 px here)
 }
 
 TEST_P(RollingShutterTest, ABandOfRowsIsThoseRowsOfTheWholeFrame) {

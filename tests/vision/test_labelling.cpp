@@ -72,3 +72,30 @@ TEST(Labelling, PixelPairsAreLabelledThroughTheDepthOfTheFirstCamera) {
   ASSERT_TRUE(bp);
   EXPECT_LT((*bp - p).norm(), 0.01);
 }
+
+// Under a rolling shutter a point's true projection is the one its own row's pose gives: the label
+// follows the moving camera row by row, and back-projection uses the pixel's row.
+TEST(Labelling, RollingShutterLabelsUseThePoseOfThePointsRow) {
+  const Scene s;
+  const auto& cam = s.a.camera;
+  std::vector<wingman::geometry::CameraPose> rows;
+  for (int r = 0; r < cam.height(); ++r) {
+    wingman::geometry::CameraPose p = s.a.pose;
+    p.position.x() += 0.02 * (r - (cam.height() - 1) / 2.0);  // 2 cm per row
+    rows.push_back(p);
+  }
+  const wingman::geometry::FramePoses poses(s.a.pose, rows);
+  const Vector3d p(3.0, 2.0, 0.0);
+  const Vector2d centre_uv = *cam.project(s.a.pose.to_camera(p));
+  const Vector2d row_uv = *cam.project(poses.to_camera(cam, p));
+  ASSERT_GT((row_uv - centre_uv).norm(), 1.0);  // the shutter moves it
+  const auto l = label_landmark_observation(p, row_uv, cam, poses, cv::Mat());
+  EXPECT_EQ(l.label, Label::Inlier);
+  EXPECT_LT(l.reprojection_px, 1e-6);
+  EXPECT_EQ(label_landmark_observation(p, centre_uv, cam, poses, cv::Mat()).reprojection_px,
+            (row_uv - centre_uv).norm());
+  const cv::Mat depth(cam.height(), cam.width(), CV_32F, cv::Scalar(15.0f));
+  const auto back = back_project(row_uv, cam, poses, depth);
+  ASSERT_TRUE(back);
+  EXPECT_LT((*back - p).norm(), 0.03);  // depth is sampled at the nearest pixel centre
+}
