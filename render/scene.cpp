@@ -124,6 +124,8 @@ Mesh terrain_mesh(const sim::WorldSpec& world, const sim::TerrainModel& terrain,
       h[j * nx + i] = terrain.height(b(0) + i * spec.resolution, b(1) + j * spec.resolution);
   const bool stretched = world.texture.mode == sim::TextureSpec::Mode::Stretched &&
                          world.texture.type == sim::TextureSpec::Type::Image;
+  const bool image = world.texture.type == sim::TextureSpec::Type::Image;
+  const double ox = image ? world.texture.origin_x : 0, oy = image ? world.texture.origin_y : 0;
   Mesh m;
   m.material = material;
   for (int j = 0; j < ny; ++j) {
@@ -136,7 +138,7 @@ Mesh terrain_mesh(const sim::WorldSpec& world, const sim::TerrainModel& terrain,
       // Image up is world +y (north); t runs down the image rows.
       Eigen::Vector2d uv = stretched
                                ? Eigen::Vector2d((x - b(0)) / (b(2) - b(0)), (b(3) - y) / (b(3) - b(1)))
-                               : Eigen::Vector2d(x / tex_w, -y / tex_h);
+                               : Eigen::Vector2d((x - ox) / tex_w, (oy - y) / tex_h);
       m.add({x, y, h[j * nx + i]}, Eigen::Vector3d(-hx, -hy, 1).normalized(), uv, {1, 1, 1});
     }
   }

@@ -48,6 +48,9 @@ struct TextureSpec {
   std::string image = "aerial/freetown_drone_nadir.jpg";  // scenario dir, then assets/
   Mode mode = Mode::Tiled;
   double tile_size = 60;     // m covered by one copy of the image (tiled)
+  // m: the world point of one copy's top-left corner (tiled), so that a flight can lie inside one
+  // copy of a large image and see no repetition.
+  double origin_x = 0, origin_y = 0;
   double detail_min = 0.02;  // m, finest and coarsest detail of the procedural texture
   double detail_max = 0.2;
   int size = 2048;           // px of the procedural texture (one tile, detail_min per texel)
@@ -67,6 +70,8 @@ struct TextureSpec {
     v("image", image);
     v.choice("mode", mode, {{"tiled", Mode::Tiled}, {"stretched", Mode::Stretched}});
     v("tile_size", tile_size, geometry::gt(0));
+    v("origin_x", origin_x);
+    v("origin_y", origin_y);
     v("detail_min", detail_min, geometry::gt(0));
     v("detail_max", detail_max, geometry::gt(0));
     v.check("detail_max", detail_max >= detail_min, "must be at least detail_min");

@@ -5,7 +5,6 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <sstream>
 
 #include "app/app_test_support.hpp"
@@ -30,13 +29,6 @@ const std::string kEffects =
     ",\n     shutter: {type: rolling, line_delay: 3.0e-5, exposure: 0.004, subframes: 3, rows_per_band: 8},"
     "\n     sensor: {model: physical, vignetting: 0.5, auto_exposure: {enabled: true, target: 0.6}}";
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(CameraEffectsCli, RenderRecordsTheShutterAndEveryFramesExposure) {
   TempDir tmp;
   write_file(tmp / "fx.yaml", scenario(kEffects));
@@ -44,12 +36,12 @@ TEST(CameraEffectsCli, RenderRecordsTheShutterAndEveryFramesExposure) {
   const auto r = run_wingman({"render", (tmp / "fx.yaml").string(), "--out", ds.string(), "--gl", "osmesa", "-q"},
                              tmp.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string yaml = read(ds / "uav1" / "mav0" / "cam0" / "sensor.yaml");
+  const std::string yaml = read_file(ds / "uav1" / "mav0" / "cam0" / "sensor.yaml");
   EXPECT_THAT(yaml, ::testing::HasSubstr("type: rolling"));
   EXPECT_THAT(yaml, ::testing::HasSubstr("line_delay_s: 3e-05"));
   EXPECT_THAT(yaml, ::testing::HasSubstr("exposure_per_frame: exposure.csv"));
   EXPECT_THAT(yaml, ::testing::HasSubstr("full_well_e: 10000"));
-  std::istringstream csv(read(ds / "uav1" / "mav0" / "cam0" / "exposure.csv"));
+  std::istringstream csv(read_file(ds / "uav1" / "mav0" / "cam0" / "exposure.csv"));
   std::string line;
   std::getline(csv, line);
   EXPECT_EQ(line, "#timestamp [ns],exposure [s],gain");
