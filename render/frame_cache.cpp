@@ -177,6 +177,7 @@ FrameKeyer::FrameKeyer(const Scene& scene, std::string_view salt) {
   const auto& l = scene.light;
   hash_doubles(s.get(), {l.direction.x(), l.direction.y(), l.direction.z(), l.ambient, l.diffuse, scene.sky.x(),
                          scene.sky.y(), scene.sky.z(), scene.near, scene.far, double(scene.msaa)});
+  if (l.shadows) hash_doubles(s.get(), {1.0, double(l.shadow_map)});  // hashed only when on
   const XXH128_hash_t h = XXH3_128bits_digest(s.get());
   scene_hi_ = h.high64;
   scene_lo_ = h.low64;

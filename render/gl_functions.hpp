@@ -46,7 +46,8 @@ namespace wingman::render {
   X(PFNGLPIXELSTOREIPROC, PixelStorei) X(PFNGLDRAWARRAYSPROC, DrawArrays)                       \
   X(PFNGLDRAWELEMENTSPROC, DrawElements) X(PFNGLFINISHPROC, Finish)                             \
   X(PFNGLMULTIDRAWELEMENTSPROC, MultiDrawElements) X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)   \
-  X(PFNGLCOLORMASKPROC, ColorMask)
+  X(PFNGLCOLORMASKPROC, ColorMask) X(PFNGLPOLYGONOFFSETPROC, PolygonOffset)                   \
+  X(PFNGLTEXPARAMETERFVPROC, TexParameterfv)
 
 struct GlFunctions {
 #define WINGMAN_GL_DECLARE(type, name) type name = nullptr;

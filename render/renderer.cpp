@@ -52,6 +52,53 @@ void main() {
 }
 )";
 
+// The same with the sun's shadow (world.light.shadows): ambient and diffuse light kept apart per
+// vertex, and the diffuse one scaled per pixel by what the shadow map lets through (2x2
+// percentage-closer filtering by the sampler's compare mode). A program of its own, so that a
+// world without shadows runs exactly the programs above.
+const char* kShadowedVs = R"(#version 330 core
+layout(location = 0) in vec3 a_pos;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in vec3 a_colour;
+uniform mat4 u_model_view;
+uniform mat4 u_proj;
+uniform mat3 u_model_rot;
+uniform mat4 u_light_from_model;
+uniform vec3 u_to_light;
+uniform float u_ambient;
+uniform float u_diffuse;
+uniform bool u_unlit;
+out vec2 v_uv;
+out vec3 v_ambient;
+out vec3 v_direct;
+out vec4 v_light;
+void main() {
+  float direct = u_unlit ? 0.0 : u_diffuse * max(dot(normalize(u_model_rot * a_normal), u_to_light), 0.0);
+  v_uv = a_uv;
+  v_ambient = a_colour * (u_unlit ? 1.0 : u_ambient);
+  v_direct = a_colour * direct;
+  v_light = u_light_from_model * vec4(a_pos, 1.0);
+  gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
+}
+)";
+
+const char* kShadowedFs = R"(#version 330 core
+in vec2 v_uv;
+in vec3 v_ambient;
+in vec3 v_direct;
+in vec4 v_light;
+uniform sampler2D u_tex;
+uniform sampler2DShadow u_shadow;
+uniform bool u_zero_to_one;
+layout(location = 0) out vec4 o_colour;
+void main() {
+  vec3 p = v_light.xyz / v_light.w;
+  float lit = texture(u_shadow, vec3(p.xy * 0.5 + 0.5, u_zero_to_one ? p.z : p.z * 0.5 + 0.5));
+  o_colour = vec4(texture(u_tex, v_uv).rgb * (v_ambient + lit * v_direct), 1.0);
+}
+)";
+
 // With MSAA, depth comes from a second, single-sample pass of the same geometry with this
 // program (no colour, no texture): the surface at the pixel centre, exactly as without MSAA, never
 // a blend of two surfaces at an edge. Colour is resolved by glBlitFramebuffer. On llvmpipe this
@@ -190,6 +237,12 @@ struct Renderer::Impl {
   GLint u_model_view = -1, u_proj = -1, u_model_rot = -1, u_tex = -1, u_to_light = -1,
         u_ambient = -1, u_diffuse = -1, u_unlit = -1;
   GLint d_model_view = -1, d_proj = -1;
+  // The shadowed colour program (kShadowedVs/Fs) and the shadow map, when the world has shadows.
+  struct Shadowed {
+    GLuint program = 0, fbo = 0, map = 0;
+    GLint model_view = -1, proj = -1, model_rot = -1, tex = -1, to_light = -1, ambient = -1, diffuse = -1,
+          unlit = -1, light_from_model = -1, shadow = -1, zero_to_one = -1;
+  } sh;
   std::vector<GpuMaterial> materials;
   std::vector<GpuMesh> static_meshes, lead_meshes;
   std::map<std::pair<int, int>, Target> targets;
@@ -331,41 +384,58 @@ struct Renderer::Impl {
                          static_cast<GLsizei>(draw_counts.size()));
   }
 
-  // The scene from view V: textured and lit (colour), or positions only (depth pass).
+  // The scene from view V: textured and lit (colour), or positions only (depth pass). light: the
+  // sun's clip space from the world, for the shadowed colour program; null for the plain one.
   void draw_scene(bool colour, const Eigen::Matrix4f& P, const Eigen::Matrix4d& V,
-                  const std::optional<Eigen::Matrix4d>& lead_model) {
-    gl.UseProgram(colour ? program : depth_program);
-    gl.UniformMatrix4fv(colour ? u_proj : d_proj, 1, GL_FALSE, P.data());
+                  const std::optional<Eigen::Matrix4d>& lead_model, const Eigen::Matrix4f* light = nullptr) {
+    const bool shadowed = colour && light;
+    gl.UseProgram(shadowed ? sh.program : colour ? program : depth_program);
+    gl.UniformMatrix4fv(shadowed ? sh.proj : colour ? u_proj : d_proj, 1, GL_FALSE, P.data());
     if (colour) {
       const Eigen::Vector3f to_light = (-info.light.direction.normalized()).cast<float>();
-      gl.Uniform3fv(u_to_light, 1, to_light.data());
-      gl.Uniform1f(u_ambient, static_cast<float>(info.light.ambient));
-      gl.Uniform1f(u_diffuse, static_cast<float>(info.light.diffuse));
-      gl.Uniform1i(u_tex, 0);
+      gl.Uniform3fv(shadowed ? sh.to_light : u_to_light, 1, to_light.data());
+      gl.Uniform1f(shadowed ? sh.ambient : u_ambient, static_cast<float>(info.light.ambient));
+      gl.Uniform1f(shadowed ? sh.diffuse : u_diffuse, static_cast<float>(info.light.diffuse));
+      gl.Uniform1i(shadowed ? sh.tex : u_tex, 0);
+      if (shadowed) {
+        gl.Uniform1i(sh.shadow, 1);
+        gl.Uniform1i(sh.zero_to_one, depth.reversed ? 1 : 0);
+        gl.ActiveTexture(GL_TEXTURE1);
+        gl.BindTexture(GL_TEXTURE_2D, sh.map);
+      }
       gl.ActiveTexture(GL_TEXTURE0);
     }
-    draw_meshes(colour, static_meshes, P, V, Eigen::Matrix4d::Identity());
-    if (lead_model) draw_meshes(colour, lead_meshes, P, V, *lead_model);
+    draw_meshes(colour, static_meshes, P, V, Eigen::Matrix4d::Identity(), light);
+    if (lead_model) draw_meshes(colour, lead_meshes, P, V, *lead_model, light);
   }
 
   void draw_meshes(bool colour, const std::vector<GpuMesh>& meshes, const Eigen::Matrix4f& P,
-                   const Eigen::Matrix4d& V, const Eigen::Matrix4d& M) {
+                   const Eigen::Matrix4d& V, const Eigen::Matrix4d& M, const Eigen::Matrix4f* light = nullptr) {
+    const bool shadowed = colour && light;
     const Eigen::Matrix4f MV = to_float(V * M);
     const Eigen::Matrix4f clip_from_model = P * MV;
-    gl.UniformMatrix4fv(colour ? u_model_view : d_model_view, 1, GL_FALSE, MV.data());
+    gl.UniformMatrix4fv(shadowed ? sh.model_view : colour ? u_model_view : d_model_view, 1, GL_FALSE, MV.data());
     if (colour) {
       const Eigen::Matrix3f R = M.topLeftCorner<3, 3>().cast<float>();
-      gl.UniformMatrix3fv(u_model_rot, 1, GL_FALSE, R.data());
+      gl.UniformMatrix3fv(shadowed ? sh.model_rot : u_model_rot, 1, GL_FALSE, R.data());
+    }
+    if (shadowed) {
+      const Eigen::Matrix4f L = *light * to_float(M);
+      gl.UniformMatrix4fv(sh.light_from_model, 1, GL_FALSE, L.data());
     }
     for (const auto& m : meshes) {
       if (colour) {
         const GpuMaterial* mat = m.material >= 0 ? &materials[m.material] : nullptr;
         gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : white);
-        gl.Uniform1i(u_unlit, mat && mat->unlit ? 1 : 0);
+        gl.Uniform1i(shadowed ? sh.unlit : u_unlit, mat && mat->unlit ? 1 : 0);
       }
       draw_visible(m, clip_from_model);
     }
   }
+
+  void setup_shadows(int size);
+  Eigen::Matrix4f render_shadow_map(const Eigen::Matrix4f& clip_from_world,
+                                    const std::optional<Eigen::Matrix4d>& lead_model);
 
   void check_fbo(const char* what) {
     const GLenum s = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
@@ -424,8 +494,90 @@ struct Renderer::Impl {
     gl.DeleteTextures(1, &white);
     gl.DeleteProgram(program);
     gl.DeleteProgram(depth_program);
+    if (sh.program) {
+      gl.DeleteProgram(sh.program);
+      gl.DeleteFramebuffers(1, &sh.fbo);
+      gl.DeleteTextures(1, &sh.map);
+    }
   }
 };
+
+void Renderer::Impl::setup_shadows(int size) {
+  sh.program = link(kShadowedVs, kShadowedFs);
+  for (auto [loc, name] : {std::pair{&sh.model_view, "u_model_view"}, {&sh.proj, "u_proj"}, {&sh.model_rot, "u_model_rot"},
+                           {&sh.tex, "u_tex"}, {&sh.to_light, "u_to_light"}, {&sh.ambient, "u_ambient"},
+                           {&sh.diffuse, "u_diffuse"}, {&sh.unlit, "u_unlit"}, {&sh.light_from_model, "u_light_from_model"},
+                           {&sh.shadow, "u_shadow"}, {&sh.zero_to_one, "u_zero_to_one"}})
+    *loc = gl.GetUniformLocation(sh.program, name);
+  gl.GenTextures(1, &sh.map);
+  gl.BindTexture(GL_TEXTURE_2D, sh.map);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, size, size, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+  const float lit[4] = {1, 1, 1, 1};  // outside the map: in the light
+  gl.TexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, lit);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  gl.GenFramebuffers(1, &sh.fbo);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, sh.fbo);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, sh.map, 0);
+  const GLenum none = GL_NONE;
+  gl.DrawBuffers(1, &none);
+  gl.ReadBuffer(GL_NONE);
+  check_fbo("shadow map");
+}
+
+// The sun's orthographic view over what the camera sees: along the light, the receivers' chunks
+// in the camera's view bound the map sideways (a caster's shadow lies where the caster does in
+// this projection) and every chunk bounds its depth, so casters outside the view still cast.
+// Returns the sun's clip space from the world.
+Eigen::Matrix4f Renderer::Impl::render_shadow_map(const Eigen::Matrix4f& clip_from_world,
+                                                  const std::optional<Eigen::Matrix4d>& lead_model) {
+  const Eigen::Vector3d d = info.light.direction.normalized();
+  const Eigen::Vector3d e1 = d.unitOrthogonal(), e2 = d.cross(e1);
+  Eigen::Matrix3d R;
+  R << e1.transpose(), e2.transpose(), d.transpose();  // world to light: x, y across, z along
+  Eigen::AlignedBox2d side;
+  double z0 = INFINITY, z1 = -INFINITY;
+  auto add = [&](const Eigen::AlignedBox3f& box, const Eigen::Matrix4d& M, bool in_view_of_camera) {
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d p = R * (M * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).cast<double>().homogeneous()).head<3>();
+      z0 = std::min(z0, p.z()), z1 = std::max(z1, p.z());
+      if (in_view_of_camera) side.extend(p.head<2>());
+    }
+  };
+  for (const auto& m : static_meshes)
+    for (const Chunk& c : m.chunks) add(c.box, Eigen::Matrix4d::Identity(), in_view(c.box, clip_from_world));
+  if (lead_model)
+    for (const auto& m : lead_meshes)
+      for (const Chunk& c : m.chunks) add(c.box, *lead_model, true);
+  if (side.isEmpty()) side.extend(Eigen::Vector2d(0, 0)).extend(Eigen::Vector2d(1, 1));
+  const double zlo = z0 - 1, zhi = z1 + 1;  // a metre of room at either end
+  Eigen::Matrix4d L = Eigen::Matrix4d::Identity();
+  const Eigen::Vector2d lo = side.min(), span = (side.max() - side.min()).cwiseMax(1e-3);
+  L.block<1, 3>(0, 0) = 2 / span.x() * R.row(0);
+  L(0, 3) = -2 * lo.x() / span.x() - 1;
+  L.block<1, 3>(1, 0) = 2 / span.y() * R.row(1);
+  L(1, 3) = -2 * lo.y() / span.y() - 1;
+  const double zs = depth.reversed ? 1 / (zhi - zlo) : 2 / (zhi - zlo);  // NDC z in [0, 1] or [-1, 1]
+  L.block<1, 3>(2, 0) = zs * R.row(2);
+  L(2, 3) = depth.reversed ? -zlo * zs : -zlo * zs - 1;
+  const Eigen::Matrix4f Lf = to_float(L);
+  const int size = info.light.shadow_map;
+  gl.BindFramebuffer(GL_FRAMEBUFFER, sh.fbo);
+  gl.Viewport(0, 0, size, size);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_LESS);
+  const float far_depth = 1;
+  gl.ClearBufferfv(GL_DEPTH, 0, &far_depth);
+  gl.Enable(GL_POLYGON_OFFSET_FILL);
+  gl.PolygonOffset(2.0f, 4.0f);  // against self-shadowing of the lit surfaces
+  draw_scene(false, Lf, Eigen::Matrix4d::Identity(), lead_model);
+  gl.Disable(GL_POLYGON_OFFSET_FILL);
+  return Lf;
+}
 
 Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::make_unique<Impl>()) {
   ctx_.make_current();
@@ -454,6 +606,7 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.u_unlit = gl.GetUniformLocation(I.program, "u_unlit");
   I.d_model_view = gl.GetUniformLocation(I.depth_program, "u_model_view");
   I.d_proj = gl.GetUniformLocation(I.depth_program, "u_proj");
+  if (scene.light.shadows) I.setup_shadows(scene.light.shadow_map);
   I.white =
       I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, false, 1);
   for (const auto& m : scene.materials) {
@@ -518,8 +671,10 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
     lead_model = M;
   }
 
-  gl.Viewport(0, 0, w, h);
   if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  std::optional<Eigen::Matrix4f> light;
+  if (I.sh.program) light = I.render_shadow_map(P * to_float(V), lead_model);
+  gl.Viewport(0, 0, w, h);
   gl.Enable(GL_DEPTH_TEST);
   gl.DepthFunc(I.depth.reversed ? GL_GREATER : GL_LESS);
   gl.Disable(GL_CULL_FACE);  // the y-flipped projection mirrors the winding; draw both faces
@@ -529,7 +684,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
   gl.ClearBufferfv(GL_COLOR, 0, sky);
   gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
-  I.draw_scene(true, P, V, lead_model);
+  I.draw_scene(true, P, V, lead_model, light ? &*light : nullptr);
   if (t.samples > 1) {
     // Colour: the samples averaged by the blit. Depth: a single-sample pass (kDepthVs).
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.ms_fbo);

@@ -421,6 +421,7 @@ Scene build_scene(const sim::WorldDescription& world) {
   const sim::WorldSpec& w = world.spec;
   Scene scene;
   scene.light = w.light;
+  if (w.light.sun.enabled) scene.light.direction = w.light.travel();
   scene.sky = w.image.sky;
   scene.near = w.near;
   scene.far = w.far;

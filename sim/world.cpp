@@ -6,6 +6,7 @@
 #include <random>
 
 #include "sim/rng.hpp"
+#include "sim/sun.hpp"
 #include "sim/scenario.hpp"
 #include "sim/truth.hpp"
 
@@ -166,6 +167,15 @@ LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world) {
   p.position = truth.lead(t).position;
   p.yaw = lead_heading(truth, t) + world.lead.yaw_offset;
   return p;
+}
+
+}  // namespace wingman::sim
+
+namespace wingman::sim {
+
+Eigen::Vector3d LightSpec::travel() const {
+  if (sun.enabled) return -sun_vector(sun.latitude, sun.longitude, sun.day_of_year, sun.time_utc);
+  return direction.normalized();
 }
 
 }  // namespace wingman::sim

@@ -123,10 +123,31 @@ struct LeadModelSpec {
   }
 };
 
+// The sun from a place and a time (sim/sun.hpp), instead of a fixed direction.
+struct SunSpec {
+  bool enabled = false;
+  double latitude = 8.48;     // deg north: Freetown, where the default ground was flown
+  double longitude = -13.23;  // deg east
+  double day_of_year = 80;    // 1-366 (80: the March equinox)
+  double time_utc = 10.5;     // h
+
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled);
+    v("latitude", latitude, geometry::in(-90, 90));
+    v("longitude", longitude, geometry::in(-180, 180));
+    v("day_of_year", day_of_year, geometry::in(1, 366));
+    v("time_utc", time_utc, geometry::in(0, 24));
+  }
+};
+
 struct LightSpec {
   Eigen::Vector3d direction{-0.4, 0.3, -1.0};  // world frame, the way the light travels
   double ambient = 0.45;
   double diffuse = 0.65;
+  SunSpec sun{};       // when enabled, it sets the direction
+  bool shadows = false;  // what the light does not reach keeps the ambient light only (shadow maps)
+  int shadow_map = 2048;  // px a side of the shadow map, over the camera's view
 
   template <class V>
   void visit(V& v) {
@@ -134,7 +155,13 @@ struct LightSpec {
     v.check("direction", direction.norm() >= 1e-9, "must not be the zero vector");
     v("ambient", ambient, geometry::in(0, 2));
     v("diffuse", diffuse, geometry::in(0, 2));
+    v.section("sun", [&](auto& x) { sun.visit(x); });
+    v.check("sun", !sun.enabled || travel().z() < 0, "the sun is below the horizon at that place and time");
+    v("shadows", shadows);
+    v("shadow_map", shadow_map, geometry::in(256, 8192));
   }
+  // The way the light travels: the sun's when it is enabled, else `direction`; unit length.
+  Eigen::Vector3d travel() const;
 };
 
 struct ImageEffectsSpec {

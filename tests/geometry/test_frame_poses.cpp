@@ -21,7 +21,7 @@ FramePoses moving(double speed_per_row) {
 
 TEST(FramePoses, APointIsOnTheRowWhosePoseProjectsItThere) {
   const FramePoses poses = moving(0.01);  // 1 cm per row: 0.1 px per row at 20 m
-  for (const Eigen::Vector3d p : {Eigen::Vector3d(3, 4, 0), Eigen::Vector3d(-10, -7, 1), Eigen::Vector3d(0, 0, 0)}) {
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(3, 4, 0), Eigen::Vector3d(-10, -7, 1), Eigen::Vector3d(0, 0, 0)}) {
     const Eigen::Vector3d p_C = poses.to_camera(kCam, p);
     const auto uv = kCam.project(p_C);
     ASSERT_TRUE(uv);

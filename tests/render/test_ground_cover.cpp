@@ -28,7 +28,7 @@ TEST(GroundCover, EveryViewOfTheParkSceneLiesInsideOneCopyOfItsMosaic) {
       const geometry::PinholeCamera cam = scn.uavs[u].camera.camera();
       const Eigen::Matrix3d R_WC = truth.camera_R_CW(u, t).transpose();
       const Eigen::Vector3d c = truth.camera(u, t).position;
-      for (const Eigen::Vector2d corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(cam.width() - 1, 0),
+      for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(cam.width() - 1, 0),
                                            Eigen::Vector2d(0, cam.height() - 1),
                                            Eigen::Vector2d(cam.width() - 1, cam.height() - 1)}) {
         const Eigen::Vector3d ray = R_WC * cam.bearing(corner);

@@ -1,0 +1,85 @@
+// Shadows from the sun, with both backends: a box's shadow falls on the ground where geometry
+// puts it (its outline cast along the light), holds the ambient light only, and the lit ground
+// keeps the brightness it has without shadows.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "geometry/rotation.hpp"
+#include "render/renderer.hpp"
+#include "render_test_support.hpp"
+
+namespace wingman::render {
+namespace {
+
+using testing::backend_name;
+
+// An axis-aligned box [x0, x1] x [y0, y1] x [0, h], lit, white.
+Mesh box(double x0, double x1, double y0, double y1, double h) {
+  Mesh m;
+  const Eigen::Vector3d c(1, 1, 1);
+  auto face = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& d, const Eigen::Vector3d& n) {
+    const auto k = static_cast<std::uint32_t>(m.vertex_count());
+    m.add(a, n, {0, 0}, c);
+    m.add(b, n, {1, 0}, c);
+    m.add(b + d - a, n, {1, 1}, c);
+    m.add(d, n, {0, 1}, c);
+    m.indices.insert(m.indices.end(), {k, k + 1, k + 2, k, k + 2, k + 3});
+  };
+  face({x0, y0, h}, {x1, y0, h}, {x0, y1, h}, {0, 0, 1});
+  face({x0, y0, 0}, {x1, y0, 0}, {x0, y0, h}, {0, -1, 0});
+  face({x0, y1, 0}, {x1, y1, 0}, {x0, y1, h}, {0, 1, 0});
+  face({x0, y0, 0}, {x0, y1, 0}, {x0, y0, h}, {-1, 0, 0});
+  face({x1, y0, 0}, {x1, y1, 0}, {x1, y0, h}, {1, 0, 0});
+  return m;
+}
+
+Scene shadow_scene(bool shadows) {
+  Scene s;
+  s.materials.push_back(Material{});  // plain white, lit
+  s.static_meshes.push_back(testing::square({0, 0, 0}, 60, {1, 1, 1}, 0));
+  s.static_meshes.push_back(box(-1, 1, -1, 1, 4));
+  s.static_meshes.back().material = 0;
+  s.light.direction = {1, 0, -1};  // 45 deg up, from the west: the shadow runs 4 m east
+  s.light.shadows = shadows;
+  s.msaa = 1;
+  return s;
+}
+
+class ShadowTest : public ::testing::TestWithParam<GlBackend> {};
+
+TEST_P(ShadowTest, ABoxsShadowFallsWhereTheLightCastsItsOutline) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  const geometry::PinholeCamera cam(500, 500, 199.5, 199.5, 400, 400);  // 6 cm a pixel at 30 m
+  const CameraView view{cam, {geometry::nadir_R_CW(), {2, 0, 30}}};
+  Renderer lit(ctx, shadow_scene(false)), shadowed(ctx, shadow_scene(true));
+  cv::Mat a, b;
+  cv::cvtColor(lit.render(view).rgb, a, cv::COLOR_RGB2GRAY);
+  cv::cvtColor(shadowed.render(view).rgb, b, cv::COLOR_RGB2GRAY);
+  auto at = [&](const cv::Mat& img, double x, double y) {
+    const auto uv = cam.project(view.pose.to_camera({x, y, 0}));
+    return static_cast<double>(img.at<std::uint8_t>(static_cast<int>(std::lround(uv->y())), static_cast<int>(std::lround(uv->x()))));
+  };
+  const double ambient = 255 * 0.45, sunlit = 255 * (0.45 + 0.65 * std::sqrt(0.5));
+  for (const auto& [x, y] : {std::pair{3.0, 0.0}, {4.5, 0.5}, {1.5, -0.8}}) EXPECT_NEAR(at(b, x, y), ambient, 2) << x << ", " << y;
+  for (const auto& [x, y] : {std::pair{6.0, 0.0}, {3.0, 1.5}, {-2.0, 0.0}, {5.5, -1.4}}) {
+    EXPECT_NEAR(at(b, x, y), sunlit, 2) << x << ", " << y;
+    EXPECT_NEAR(at(b, x, y), at(a, x, y), 1) << x << ", " << y;
+  }
+  // The outline: across y at x = 3 the shadow ends at y = +-1, and along x at y = 0 at x = 5.
+  auto edge = [&](Eigen::Vector2d from, Eigen::Vector2d to) {
+    for (int i = 0; i <= 400; ++i) {
+      const Eigen::Vector2d p = from + (to - from) * i / 400.0;
+      if (at(b, p.x(), p.y()) > (ambient + sunlit) / 2) return p;
+    }
+    return to;
+  };
+  EXPECT_NEAR(edge({3, 0}, {3, 3}).y(), 1.0, 0.15);
+  EXPECT_NEAR(edge({3, 0}, {3, -3}).y(), -1.0, 0.15);
+  EXPECT_NEAR(edge({3, 0}, {8, 0}).x(), 5.0, 0.15);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, ShadowTest, ::testing::Values(GlBackend::Egl, GlBackend::OsMesa), backend_name);
+
+}  // namespace
+}  // namespace wingman::render
