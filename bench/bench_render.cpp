@@ -215,7 +215,8 @@ void quality_sweep(benchmark::State& state, render::GlBackend backend) {
 // scenes/paper_rendered_fast.yaml (MSAA 1, anisotropy 1) at t = 20 s, through the imaging chain
 // the runs use (app/pipeline/camera_imaging.hpp). Argument: 0 ideal, 1 exposure blur (9 images),
 // 2 rolling shutter exact (every row its own pose), 3 rolling shutter in bands of 10 rows,
-// 4 physical sensor with auto-exposure, 5 all of them (bands of 10, 5 images, physical sensor).
+// 4 physical sensor with auto-exposure, 5 all of them (bands of 10, 5 images, physical sensor),
+// 6 the sun's shadows (a 2048 px shadow map each frame).
 void set_camera_effect(sim::CameraSpec& c, int effect) {
   using S = sim::ShutterSpec;
   if (effect == 1 || effect == 5) c.shutter.exposure = 0.01, c.shutter.subframes = effect == 1 ? 9 : 5;
@@ -235,6 +236,7 @@ void set_camera_effect(sim::CameraSpec& c, int effect) {
 void camera_effect(benchmark::State& state, render::GlBackend backend) {
   sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_rendered_fast.yaml").front();
   set_camera_effect(scn.uavs[0].camera, static_cast<int>(state.range(0)));
+  scn.world.light.shadows = state.range(0) == 6;
   const auto ctx = context_or_skip(state, backend);
   if (!ctx) return;
   render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
@@ -254,7 +256,7 @@ void camera_effect(benchmark::State& state, render::GlBackend backend) {
 }
 
 void BM_CameraEffectEgl(benchmark::State& s) { camera_effect(s, render::GlBackend::Egl); }
-BENCHMARK(BM_CameraEffectEgl)->DenseRange(0, 5)->ArgName("effect")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_CameraEffectEgl)->DenseRange(0, 6)->ArgName("effect")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_QualitySweepEgl(benchmark::State& s) { quality_sweep(s, render::GlBackend::Egl); }
 // Arguments as BM_RenderEgl's. One iteration: 24 frames per setting.

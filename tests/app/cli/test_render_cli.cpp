@@ -196,6 +196,13 @@ TEST(RenderCli, InterruptLeavesNoDatasetBehind) {
     const int fd = ::open("/dev/null", O_WRONLY);
     dup2(fd, 1);
     dup2(fd, 2);
+#ifdef __SANITIZE_ADDRESS__
+    // GCC 12's LeakSanitizer crashes at this exit (its tracer reads a bogus dynamic-TLS range left
+    // by the GL libraries opened at run time: "Tracer caught signal 11 ... LeakSanitizer has
+    // encountered a fatal error"), which turns the exit status into 1; this test checks the
+    // status and the cleanup, and every other test keeps leak checking.
+    setenv("ASAN_OPTIONS", "detect_leaks=0", 1);
+#endif
     execl(kBinary.c_str(), "wingman", "render", scn.c_str(), "--out", out.c_str(), "--gl", "osmesa",
           static_cast<char*>(nullptr));
     _exit(127);
