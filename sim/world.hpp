@@ -148,6 +148,7 @@ struct LightSpec {
   SunSpec sun{};       // when enabled, it sets the direction
   bool shadows = false;  // what the light does not reach keeps the ambient light only (shadow maps)
   int shadow_map = 2048;  // px a side of the shadow map, over the camera's view
+  double haze_visibility = 0;  // m of meteorological visibility (render/haze.hpp); 0: clear air
 
   template <class V>
   void visit(V& v) {
@@ -159,6 +160,7 @@ struct LightSpec {
     v.check("sun", !sun.enabled || travel().z() < 0, "the sun is below the horizon at that place and time");
     v("shadows", shadows);
     v("shadow_map", shadow_map, geometry::in(256, 8192));
+    v("haze_visibility", haze_visibility, geometry::ge(0));
   }
   // The way the light travels: the sun's when it is enabled, else `direction`; unit length.
   Eigen::Vector3d travel() const;

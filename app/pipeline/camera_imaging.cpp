@@ -48,6 +48,9 @@ CameraImaging::CameraImaging(const sim::Scenario& scn, int uav)
     : scn_(scn),
       uav_(uav),
       model_(scn.uavs[uav].camera.camera()),
+      haze_(scn.world.light.haze_visibility > 0
+                ? std::optional<render::Haze>(std::in_place, model_, scn.world.light.haze_visibility, scn.world.image.sky)
+                : std::nullopt),
       sensor_(scn.uavs[uav].camera.sensor, scn.uavs[uav].camera.shutter.exposure, model_, scn.seed,
               scn.uavs[uav].name),
       effects_(scn.world.image, scn.seed, scn.uavs[uav].name) {}
@@ -67,6 +70,7 @@ TakenFrame CameraImaging::take(const sim::Truth& truth, double t, const Draw& dr
     return draw({model_, pose_after(truth, uav_, t, k, dt)}, sim::lead_pose(truth, t + dt, scn_.world), row0, rows);
   });
   out.poses = true_poses(scn_, truth, uav_, t);
+  if (haze_) haze_->apply(out.frame);
   out.exposure = sensor_.apply(out.frame);
   effects_.apply(out.frame);
   return out;

@@ -1,5 +1,6 @@
 // One UAV camera's imaging chain, shared by the SLAM loop's renderer and `wingman render`: the
-// shutter (exposure blur, rolling shutter; render/shutter.hpp) over the true motion, the sensor
+// shutter (exposure blur, rolling shutter; render/shutter.hpp) over the true motion, the haze of the
+// air (render/haze.hpp), the sensor
 // (noise, response, auto-exposure; render/sensor.hpp) and the world's image effects. It returns
 // the frame with the poses it was taken from (one per row under a rolling shutter), so that
 // labels and datasets follow the effects exactly.
@@ -8,10 +9,12 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "datasets/dataset.hpp"
 #include "geometry/frame_poses.hpp"
 #include "render/effects.hpp"
+#include "render/haze.hpp"
 #include "render/renderer.hpp"
 #include "render/sensor.hpp"
 #include "sim/scenario.hpp"
@@ -51,6 +54,7 @@ class CameraImaging {
   const sim::Scenario& scn_;
   int uav_;
   geometry::PinholeCamera model_;
+  std::optional<render::Haze> haze_;
   render::SensorModel sensor_;
   render::ImageEffects effects_;
 };
