@@ -178,6 +178,12 @@ FrameKeyer::FrameKeyer(const Scene& scene, std::string_view salt) {
   hash_doubles(s.get(), {l.direction.x(), l.direction.y(), l.direction.z(), l.ambient, l.diffuse, scene.sky.x(),
                          scene.sky.y(), scene.sky.z(), scene.near, scene.far, double(scene.msaa)});
   if (l.shadows) hash_doubles(s.get(), {1.0, double(l.shadow_map)});  // hashed only when on
+  timed_ = !scene.clouds.empty();
+  if (timed_) {
+    const sim::CloudSpec& c = l.clouds;
+    hash_mat(s.get(), scene.clouds);
+    hash_doubles(s.get(), {c.scale, c.height, c.wind.x(), c.wind.y(), c.transmission});
+  }
   const XXH128_hash_t h = XXH3_128bits_digest(s.get());
   scene_hi_ = h.high64;
   scene_lo_ = h.low64;
@@ -194,6 +200,7 @@ FrameKey FrameKeyer::key(const CameraView& view, const std::optional<LeadPose>& 
   v.insert(v.end(), R.data(), R.data() + 9);
   v.insert(v.end(), p.data(), p.data() + 3);
   if (lead) v.insert(v.end(), {1.0, lead->position.x(), lead->position.y(), lead->position.z(), lead->yaw});
+  if (timed_) v.push_back(view.time);
   std::vector<std::uint8_t> bytes(sizeof scene + v.size() * sizeof(double));
   std::memcpy(bytes.data(), scene, sizeof scene);
   std::memcpy(bytes.data() + sizeof scene, v.data(), v.size() * sizeof(double));

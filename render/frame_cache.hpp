@@ -36,6 +36,7 @@ class FrameKeyer {
 
  private:
   std::uint64_t scene_hi_ = 0, scene_lo_ = 0;
+  bool timed_ = false;  // the frame depends on its time (drifting cloud shadows)
 };
 
 // How an entry's pixels are stored (bench/bench_frame_cache.cpp measures each). Raw is the

@@ -65,15 +65,23 @@ uniform mat4 u_model_view;
 uniform mat4 u_proj;
 uniform mat3 u_model_rot;
 uniform mat4 u_light_from_model;
+uniform mat4 u_model;
 uniform vec3 u_to_light;
 uniform float u_ambient;
 uniform float u_diffuse;
 uniform bool u_unlit;
+uniform vec2 u_cloud_offset;  // m the clouds have drifted
+uniform float u_cloud_period;  // m the cloud texture spans
+uniform float u_cloud_height;
 out vec2 v_uv;
 out vec3 v_ambient;
 out vec3 v_direct;
 out vec4 v_light;
+out vec2 v_cloud;
 void main() {
+  // Where the ray to the sun crosses the cloud layer.
+  vec3 p = (u_model * vec4(a_pos, 1.0)).xyz;
+  v_cloud = (p.xy + u_to_light.xy * (u_cloud_height - p.z) / max(u_to_light.z, 0.05) - u_cloud_offset) / u_cloud_period;
   float direct = u_unlit ? 0.0 : u_diffuse * max(dot(normalize(u_model_rot * a_normal), u_to_light), 0.0);
   v_uv = a_uv;
   v_ambient = a_colour * (u_unlit ? 1.0 : u_ambient);
@@ -88,13 +96,17 @@ in vec2 v_uv;
 in vec3 v_ambient;
 in vec3 v_direct;
 in vec4 v_light;
+in vec2 v_cloud;
 uniform sampler2D u_tex;
 uniform sampler2DShadow u_shadow;
+uniform sampler2D u_clouds;
 uniform bool u_zero_to_one;
+uniform float u_cloud_block;  // 1 - the direct sun a cloud lets through; 0: no clouds
 layout(location = 0) out vec4 o_colour;
 void main() {
   vec3 p = v_light.xyz / v_light.w;
   float lit = texture(u_shadow, vec3(p.xy * 0.5 + 0.5, u_zero_to_one ? p.z : p.z * 0.5 + 0.5));
+  lit *= 1.0 - u_cloud_block * texture(u_clouds, v_cloud).r;
   o_colour = vec4(texture(u_tex, v_uv).rgb * (v_ambient + lit * v_direct), 1.0);
 }
 )";
@@ -239,9 +251,11 @@ struct Renderer::Impl {
   GLint d_model_view = -1, d_proj = -1;
   // The shadowed colour program (kShadowedVs/Fs) and the shadow map, when the world has shadows.
   struct Shadowed {
-    GLuint program = 0, fbo = 0, map = 0;
+    GLuint program = 0, fbo = 0, map = 0, clouds = 0;
     GLint model_view = -1, proj = -1, model_rot = -1, tex = -1, to_light = -1, ambient = -1, diffuse = -1,
-          unlit = -1, light_from_model = -1, shadow = -1, zero_to_one = -1;
+          unlit = -1, light_from_model = -1, shadow = -1, zero_to_one = -1, model = -1, cloud_tex = -1,
+          cloud_offset = -1, cloud_period = -1, cloud_height = -1, cloud_block = -1;
+    double time = 0;  // s of the frame being drawn
   } sh;
   std::vector<GpuMaterial> materials;
   std::vector<GpuMesh> static_meshes, lead_meshes;
@@ -402,6 +416,15 @@ struct Renderer::Impl {
         gl.Uniform1i(sh.zero_to_one, depth.reversed ? 1 : 0);
         gl.ActiveTexture(GL_TEXTURE1);
         gl.BindTexture(GL_TEXTURE_2D, sh.map);
+        const sim::CloudSpec& c = info.light.clouds;
+        const Eigen::Vector2f drift = (c.wind.head<2>() * sh.time).cast<float>();
+        gl.Uniform1i(sh.cloud_tex, 2);
+        gl.Uniform2fv(sh.cloud_offset, 1, drift.data());
+        gl.Uniform1f(sh.cloud_period, static_cast<float>(8 * c.scale));
+        gl.Uniform1f(sh.cloud_height, static_cast<float>(c.height));
+        gl.Uniform1f(sh.cloud_block, sh.clouds ? static_cast<float>(1 - c.transmission) : 0.f);
+        gl.ActiveTexture(GL_TEXTURE2);
+        gl.BindTexture(GL_TEXTURE_2D, sh.clouds ? sh.clouds : white);
       }
       gl.ActiveTexture(GL_TEXTURE0);
     }
@@ -420,8 +443,9 @@ struct Renderer::Impl {
       gl.UniformMatrix3fv(shadowed ? sh.model_rot : u_model_rot, 1, GL_FALSE, R.data());
     }
     if (shadowed) {
-      const Eigen::Matrix4f L = *light * to_float(M);
+      const Eigen::Matrix4f L = *light * to_float(M), Mf = to_float(M);
       gl.UniformMatrix4fv(sh.light_from_model, 1, GL_FALSE, L.data());
+      gl.UniformMatrix4fv(sh.model, 1, GL_FALSE, Mf.data());
     }
     for (const auto& m : meshes) {
       if (colour) {
@@ -433,7 +457,7 @@ struct Renderer::Impl {
     }
   }
 
-  void setup_shadows(int size);
+  void setup_shadows(int size, const cv::Mat& clouds);
   Eigen::Matrix4f render_shadow_map(const Eigen::Matrix4f& clip_from_world,
                                     const std::optional<Eigen::Matrix4d>& lead_model);
 
@@ -495,6 +519,7 @@ struct Renderer::Impl {
     gl.DeleteProgram(program);
     gl.DeleteProgram(depth_program);
     if (sh.program) {
+      if (sh.clouds) gl.DeleteTextures(1, &sh.clouds);
       gl.DeleteProgram(sh.program);
       gl.DeleteFramebuffers(1, &sh.fbo);
       gl.DeleteTextures(1, &sh.map);
@@ -502,12 +527,16 @@ struct Renderer::Impl {
   }
 };
 
-void Renderer::Impl::setup_shadows(int size) {
+void Renderer::Impl::setup_shadows(int size, const cv::Mat& clouds) {
+  if (!clouds.empty()) sh.clouds = upload_texture(clouds, true, true, true, 1);
   sh.program = link(kShadowedVs, kShadowedFs);
   for (auto [loc, name] : {std::pair{&sh.model_view, "u_model_view"}, {&sh.proj, "u_proj"}, {&sh.model_rot, "u_model_rot"},
                            {&sh.tex, "u_tex"}, {&sh.to_light, "u_to_light"}, {&sh.ambient, "u_ambient"},
                            {&sh.diffuse, "u_diffuse"}, {&sh.unlit, "u_unlit"}, {&sh.light_from_model, "u_light_from_model"},
-                           {&sh.shadow, "u_shadow"}, {&sh.zero_to_one, "u_zero_to_one"}})
+                           {&sh.shadow, "u_shadow"}, {&sh.zero_to_one, "u_zero_to_one"}, {&sh.model, "u_model"},
+                           {&sh.cloud_tex, "u_clouds"}, {&sh.cloud_offset, "u_cloud_offset"},
+                           {&sh.cloud_period, "u_cloud_period"}, {&sh.cloud_height, "u_cloud_height"},
+                           {&sh.cloud_block, "u_cloud_block"}})
     *loc = gl.GetUniformLocation(sh.program, name);
   gl.GenTextures(1, &sh.map);
   gl.BindTexture(GL_TEXTURE_2D, sh.map);
@@ -606,7 +635,7 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.u_unlit = gl.GetUniformLocation(I.program, "u_unlit");
   I.d_model_view = gl.GetUniformLocation(I.depth_program, "u_model_view");
   I.d_proj = gl.GetUniformLocation(I.depth_program, "u_proj");
-  if (scene.light.shadows) I.setup_shadows(scene.light.shadow_map);
+  if (scene.light.shadows) I.setup_shadows(scene.light.shadow_map, scene.clouds);
   I.white =
       I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, false, 1);
   for (const auto& m : scene.materials) {
@@ -673,6 +702,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
 
   if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   std::optional<Eigen::Matrix4f> light;
+  I.sh.time = view.time;
   if (I.sh.program) light = I.render_shadow_map(P * to_float(V), lead_model);
   gl.Viewport(0, 0, w, h);
   gl.Enable(GL_DEPTH_TEST);

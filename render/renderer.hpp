@@ -26,6 +26,7 @@ namespace wingman::render {
 struct CameraView {
   geometry::PinholeCamera camera;
   geometry::CameraPose pose;
+  double time = 0;  // s: what moves with time but is no pose (the clouds' shadows)
 };
 
 struct Frame {

@@ -101,6 +101,28 @@ cv::Mat procedural_ground(const sim::TextureSpec& t, std::uint64_t seed) {
   return out;
 }
 
+// Cloud density over a period of 8 cloud scales: periodic noise at 8 and 16 cells a period (clouds
+// of about `scale` metres, with ragged edges), thresholded at the quantile that covers `cover` of
+// the sky with an edge `softness` wide in that quantile.
+cv::Mat cloud_field(const sim::CloudSpec& c, std::uint64_t seed) {
+  auto rng = sim::make_stream(seed, "clouds");
+  const int size = 512;
+  cv::Mat n = periodic_noise(rng, size, 8) + 0.5 * periodic_noise(rng, size, 16) + 0.25 * periodic_noise(rng, size, 32);
+  std::vector<float> sorted(n.begin<float>(), n.end<float>());
+  std::sort(sorted.begin(), sorted.end());
+  auto quantile = [&](double q) {
+    return sorted[static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * (sorted.size() - 1))];
+  };
+  const float lo = quantile(1 - c.cover - c.softness / 2), hi = quantile(1 - c.cover + c.softness / 2);
+  cv::Mat out(size, size, CV_8U);
+  for (int r = 0; r < size; ++r)
+    for (int col = 0; col < size; ++col) {
+      const float x = std::clamp((n.at<float>(r, col) - lo) / std::max(hi - lo, 1e-6f), 0.f, 1.f);
+      out.at<std::uint8_t>(r, col) = cv::saturate_cast<std::uint8_t>(255 * x * x * (3 - 2 * x));
+    }
+  return out;
+}
+
 // Grey detail for the objects' surfaces (tinted by vertex colour).
 cv::Mat detail_texture(std::uint64_t seed) {
   auto rng = sim::make_stream(seed, "object_texture");
@@ -422,6 +444,7 @@ Scene build_scene(const sim::WorldDescription& world) {
   Scene scene;
   scene.light = w.light;
   if (w.light.sun.enabled) scene.light.direction = w.light.travel();
+  if (w.light.clouds.cover > 0) scene.clouds = cloud_field(w.light.clouds, world.seed);
   scene.sky = w.image.sky;
   scene.near = w.near;
   scene.far = w.far;

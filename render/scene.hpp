@@ -46,6 +46,7 @@ struct Scene {
   Eigen::Vector3d sky{0.62, 0.74, 0.88};
   double near = 0.1, far = 1000;
   int msaa = 4;
+  cv::Mat clouds;  // CV_8UC1, periodic cloud density over light.clouds.scale metres (empty: none)
 };
 
 // Pose of the lead's reference point: position in the world and heading about world z.

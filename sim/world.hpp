@@ -141,6 +141,27 @@ struct SunSpec {
   }
 };
 
+// Clouds between the sun and the ground: their shadows, drifting with the wind (render/renderer.cpp,
+// the shadowed program). A seeded periodic field, thresholded to `cover`.
+struct CloudSpec {
+  double cover = 0;          // fraction of the sky covered (0: none)
+  double scale = 150;        // m across a cloud, roughly
+  double height = 1000;      // m above z = 0 of the cloud layer
+  Eigen::Vector3d wind{4, 1, 0};  // m/s (z unused)
+  double transmission = 0.35;  // of the direct sun through a cloud
+  double softness = 0.15;    // of a cloud's edge, in the field's units (0-1)
+
+  template <class V>
+  void visit(V& v) {
+    v("cover", cover, geometry::in(0, 1));
+    v("scale", scale, geometry::gt(0));
+    v("height", height, geometry::gt(0));
+    v("wind", wind);
+    v("transmission", transmission, geometry::in(0, 1));
+    v("softness", softness, geometry::in(0.001, 1));
+  }
+};
+
 struct LightSpec {
   Eigen::Vector3d direction{-0.4, 0.3, -1.0};  // world frame, the way the light travels
   double ambient = 0.45;
@@ -149,6 +170,7 @@ struct LightSpec {
   bool shadows = false;  // what the light does not reach keeps the ambient light only (shadow maps)
   int shadow_map = 2048;  // px a side of the shadow map, over the camera's view
   double haze_visibility = 0;  // m of meteorological visibility (render/haze.hpp); 0: clear air
+  CloudSpec clouds{};
 
   template <class V>
   void visit(V& v) {
@@ -161,6 +183,8 @@ struct LightSpec {
     v("shadows", shadows);
     v("shadow_map", shadow_map, geometry::in(256, 8192));
     v("haze_visibility", haze_visibility, geometry::ge(0));
+    v.section("clouds", [&](auto& x) { clouds.visit(x); });
+    v.check("clouds", clouds.cover == 0 || shadows, "cloud shadows need shadows: true");
   }
   // The way the light travels: the sun's when it is enabled, else `direction`; unit length.
   Eigen::Vector3d travel() const;

@@ -67,7 +67,8 @@ TakenFrame CameraImaging::take(const sim::Truth& truth, double t, const Draw& dr
   // The sensor's exposure (auto-exposure's) when it is physical; the shutter's otherwise.
   const double exposure = sensor_.physical() ? sensor_.next().exposure_s : shutter.exposure;
   out.frame = render::expose(shutter, exposure, model_.width(), model_.height(), [&](double dt, int row0, int rows) {
-    return draw({model_, pose_after(truth, uav_, t, k, dt)}, sim::lead_pose(truth, t + dt, scn_.world), row0, rows);
+    return draw({model_, pose_after(truth, uav_, t, k, dt), t + dt}, sim::lead_pose(truth, t + dt, scn_.world), row0,
+                rows);
   });
   out.poses = true_poses(scn_, truth, uav_, t);
   if (haze_) haze_->apply(out.frame);

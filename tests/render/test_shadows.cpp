@@ -79,6 +79,41 @@ TEST_P(ShadowTest, ABoxsShadowFallsWhereTheLightCastsItsOutline) {
   EXPECT_NEAR(edge({3, 0}, {8, 0}).x(), 5.0, 0.15);
 }
 
+// Clouds 100 m up whose texture is cloud on its left half over a 40 m period: under a light
+// travelling (0.3, 0, -1) a ground point x looks toward the sun through the layer at x - 30 m, so
+// cloud shades x in [-10, 10) (mod 40) at t = 0, and the wind carries that band 3 m east a second.
+TEST_P(ShadowTest, CloudShadowsFallWhereTheSunLooksThroughTheLayerAndDriftWithTheWind) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  Scene s;
+  s.materials.push_back(Material{});
+  s.static_meshes.push_back(testing::square({0, 0, 0}, 200, {1, 1, 1}, 0));
+  s.light.direction = {0.3, 0, -1};
+  s.light.ambient = 0.3, s.light.diffuse = 0.5;
+  s.light.shadows = true;
+  s.light.clouds = {.cover = 0.5, .scale = 5, .height = 100, .wind = {3, 0, 0}, .transmission = 0.35, .softness = 0.1};
+  s.clouds = cv::Mat(512, 512, CV_8U, cv::Scalar(0));
+  s.clouds(cv::Rect(0, 0, 256, 512)).setTo(255);
+  s.msaa = 1;
+  const geometry::PinholeCamera cam(500, 500, 199.5, 199.5, 400, 400);  // +-12 m at 30 m
+  Renderer r(ctx, s);
+  const double direct = 0.5 * 1 / std::sqrt(1 + 0.09);
+  const double lit = 255 * (0.3 + direct), shaded = 255 * (0.3 + 0.35 * direct);
+  for (const double t : {0.0, 1.0}) {
+    const CameraView view{cam, {geometry::nadir_R_CW(), {0, 0, 30}}, t};
+    cv::Mat g;
+    cv::cvtColor(r.render(view).rgb, g, cv::COLOR_RGB2GRAY);
+    auto at = [&](double x) {
+      const auto uv = cam.project(view.pose.to_camera({x, 0, 0}));
+      return static_cast<double>(g.at<std::uint8_t>(static_cast<int>(std::lround(uv->y())), static_cast<int>(std::lround(uv->x()))));
+    };
+    for (double x = -11.5; x <= 11.5; x += 1.0) {
+      const double u = std::fmod(std::fmod(x - 30 - 3 * t, 40) + 40, 40);  // m into the period
+      if (std::abs(u - 20) < 0.3 || u < 0.3 || u > 39.7) continue;        // the edges blur a texel
+      EXPECT_NEAR(at(x), u < 20 ? shaded : lit, 3) << "t " << t << ", x " << x;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, ShadowTest, ::testing::Values(GlBackend::Egl, GlBackend::OsMesa), backend_name);
 
 }  // namespace
