@@ -1,12 +1,13 @@
 #include "render/haze.hpp"
 
 #include <cmath>
-#include <vector>
+
+#include "render/linear_light.hpp"
 
 namespace wingman::render {
 
 Haze::Haze(const geometry::PinholeCamera& cam, double visibility_m, const Eigen::Vector3d& airlight_rgb)
-    : beta_(3.912 / visibility_m), airlight_(airlight_rgb.array().pow(2.2)) {
+    : beta_(3.912 / visibility_m), airlight_(airlight_rgb.array().pow(kRenderedGamma)) {
   ray_length_.create(cam.height(), cam.width(), CV_32F);
   for (int r = 0; r < cam.height(); ++r)
     for (int c = 0; c < cam.width(); ++c)
@@ -17,8 +18,7 @@ Haze::Haze(const geometry::PinholeCamera& cam, double visibility_m, const Eigen:
 double Haze::transmission(double range_m) const { return std::exp(-beta_ * range_m); }
 
 void Haze::apply(Frame& f) const {
-  std::vector<float> to_linear(256);
-  for (int i = 0; i < 256; ++i) to_linear[i] = static_cast<float>(std::pow(i / 255.0, 2.2));
+  const auto& to_linear = linear_of_8bit();
   for (int r = 0; r < f.rgb.rows; ++r) {
     auto* px = f.rgb.ptr<cv::Vec3b>(r);
     const auto* z = f.depth.ptr<float>(r);
@@ -28,7 +28,7 @@ void Haze::apply(Frame& f) const {
       const double t = transmission(z[c] * k[c]);
       for (int ch = 0; ch < 3; ++ch) {
         const double lin = to_linear[px[c][ch]] * t + airlight_[ch] * (1 - t);
-        px[c][ch] = cv::saturate_cast<std::uint8_t>(255 * std::pow(lin, 1 / 2.2));
+        px[c][ch] = cv::saturate_cast<std::uint8_t>(255 * std::pow(lin, 1 / kRenderedGamma));
       }
     }
   }

@@ -6,12 +6,12 @@
 #include <cmath>
 #include <vector>
 
+#include "render/linear_light.hpp"
 #include "sim/rng.hpp"
 
 namespace wingman::render {
 namespace {
 
-constexpr double kRenderedGamma = 2.2;  // how the renderer's 8-bit image encodes radiance
 constexpr double kPoissonBelow = 30;    // e-: exact Poisson below, its normal limit above
 
 double dn_max(const sim::SensorSpec& s) { return std::ldexp(1.0, s.bits) - 1; }
@@ -24,6 +24,10 @@ SensorModel::SensorModel(const sim::SensorSpec& sensor, double exposure_s, const
   next_.exposure_s = spec_.initial_exposure(exposure_s);
   next_.gain = spec_.gain;
   if (!physical()) return;
+  const double top = dn_max(spec_);
+  to_output_.resize(static_cast<std::size_t>(top) + 1);
+  for (std::size_t d = 0; d < to_output_.size(); ++d)
+    to_output_[d] = cv::saturate_cast<std::uint8_t>(255 * std::pow(d / top, 1 / spec_.gamma));
   // The fixed pattern: drawn once per camera, the same in every frame.
   std::mt19937_64 fixed = sim::make_stream(seed, "sensor_pattern/" + camera);
   std::normal_distribution<double> n01(0, 1);
@@ -57,11 +61,7 @@ Exposure SensorModel::apply(Frame& f) {
   const Exposure used = next_;
   if (!physical()) return used;
   const double top = dn_max(spec_), k = used.gain * top / spec_.full_well;
-  std::vector<float> to_linear(256);
-  for (int i = 0; i < 256; ++i) to_linear[i] = static_cast<float>(std::pow(i / 255.0, kRenderedGamma));
-  std::vector<std::uint8_t> to_output(static_cast<std::size_t>(top) + 1);
-  for (std::size_t d = 0; d < to_output.size(); ++d)
-    to_output[d] = cv::saturate_cast<std::uint8_t>(255 * std::pow(d / top, 1 / spec_.gamma));
+  const auto& to_linear = linear_of_8bit();
   cv::Mat shot(f.rgb.size(), CV_32FC3), read(f.rgb.size(), CV_32FC3);
   cv::RNG noise(rng_());
   noise.fill(shot, cv::RNG::NORMAL, 0, 1);
@@ -80,7 +80,7 @@ Exposure SensorModel::apply(Frame& f) {
                                       : mean + std::sqrt(mean) * zs[i];
       e += zr[i];
       const double dn = std::clamp(std::round(e * k), 0.0, top);
-      px[i] = to_output[static_cast<std::size_t>(dn)];
+      px[i] = to_output_[static_cast<std::size_t>(dn)];
     }
   }
   update_auto_exposure(f.rgb);

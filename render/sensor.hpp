@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -49,6 +50,7 @@ class SensorModel {
   Exposure next_;
   cv::Mat pixel_gain_;    // CV_32F: vignetting times (1 + PRNU)
   cv::Mat dark_offset_;   // CV_32F, e-: DSNU
+  std::vector<std::uint8_t> to_output_;  // the response curve: 8-bit output of each digital number
   std::mt19937_64 rng_;
 };
 

@@ -3,25 +3,15 @@
 #include <opencv2/core.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
+
+#include "render/linear_light.hpp"
 
 namespace wingman::render {
 namespace {
 
-constexpr double kGamma = 2.2;
-
-const std::array<float, 256>& to_linear() {
-  static const std::array<float, 256> lut = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) t[i] = static_cast<float>(std::pow(i / 255.0, kGamma));
-    return t;
-  }();
-  return lut;
-}
-
 void accumulate(const cv::Mat& rgb, cv::Mat& sum, int row0) {
-  const auto& lut = to_linear();
+  const auto& lut = linear_of_8bit();
   for (int r = 0; r < rgb.rows; ++r) {
     const auto* in = rgb.ptr<std::uint8_t>(r);
     auto* out = sum.ptr<float>(row0 + r);
@@ -31,7 +21,7 @@ void accumulate(const cv::Mat& rgb, cv::Mat& sum, int row0) {
 
 cv::Mat encode(const cv::Mat& sum, double scale) {
   cv::Mat lin = sum * scale, enc;
-  cv::pow(cv::max(lin, 0.0), 1.0 / kGamma, enc);
+  cv::pow(cv::max(lin, 0.0), 1.0 / kRenderedGamma, enc);
   cv::Mat out;
   enc.convertTo(out, CV_8UC3, 255.0);  // rounds and saturates
   return out;
