@@ -243,7 +243,7 @@ void camera_effect(benchmark::State& state, render::GlBackend backend) {
   const sim::OpenLoopTruth truth(scn);
   app::CameraImaging imaging(scn, 0);
   auto draw = [&](const render::CameraView& v, const render::LeadPose& l, int row0, int rows) {
-    return rows == v.camera.height() ? renderer.render(v, l) : renderer.render_rows(v, l, row0, rows);
+    return renderer.render_rows(v, l, row0, rows);
   };
   imaging.take(truth, 20.0, draw);  // warm-up
   const double cpu0 = process_cpu_seconds();

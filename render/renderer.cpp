@@ -804,6 +804,7 @@ Frame Renderer::render_rows(const CameraView& view, const std::optional<LeadPose
   if (row0 < 0 || rows < 1 || row0 + rows > cam.height())
     throw std::invalid_argument("render_rows: rows " + std::to_string(row0) + " + " + std::to_string(rows) +
                                 " outside an image of " + std::to_string(cam.height()));
+  if (row0 == 0 && rows == cam.height()) return render(view, lead);
   // The band is an image of its own whose principal point sits row0 rows higher.
   if (cam.distortion().is_zero())
     return render_pinhole(cam.fx(), cam.fy(), cam.cx(), cam.cy() - row0, cam.width(), rows, view, lead);

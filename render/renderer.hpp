@@ -45,7 +45,7 @@ class Renderer {
 
   Frame render(const CameraView& view, const std::optional<LeadPose>& lead = std::nullopt);
   // Rows [row0, row0 + rows) of that image, and only they are drawn (a rolling shutter's band):
-  // the same pixels as render()'s rows.
+  // the same pixels as render()'s rows; all of them is render() itself.
   Frame render_rows(const CameraView& view, const std::optional<LeadPose>& lead, int row0, int rows);
   const GlContext& context() const { return ctx_; }
 

@@ -184,7 +184,7 @@ int render_command(const RenderOptions& o, const std::string& variant) {
       const auto& u = scn.uavs[j];
       app::TakenFrame f = imaging[j].take(truth, t, [&](const render::CameraView& view, const render::LeadPose& l,
                                                         int row0, int rows) {
-        return rows == view.camera.height() ? renderer.render(view, l) : renderer.render_rows(view, l, row0, rows);
+        return renderer.render_rows(view, l, row0, rows);
       });
       const geometry::CameraPose& centre = f.poses.centre();
       writer.write_frame(u.name, t_ns, f.frame.rgb, f.frame.depth);

@@ -45,7 +45,6 @@ render::Frame RendererFrames::render(const render::CameraView& view, const rende
     renderer_ = std::make_unique<render::Renderer>(*ctx_, *scene_);
     scene_.reset();
   }
-  if (row0 == 0 && rows == view.camera.height()) return renderer_->render(view, lead);
   return renderer_->render_rows(view, lead, row0, rows);
 }
 
