@@ -40,7 +40,6 @@ struct ShutterSpec {
     v.check("line_delay", type == Type::Global || line_delay > 0, "must be above 0 for a rolling shutter");
   }
   bool rolling() const { return type == Type::Rolling && line_delay > 0; }
-  bool blurs() const { return exposure > 0 && subframes > 1; }
 };
 
 // Auto-exposure: after each frame the exposure (then the gain, once exposure is at its maximum)

@@ -55,18 +55,20 @@ CameraImaging::CameraImaging(const sim::Scenario& scn, int uav)
               scn.uavs[uav].name),
       effects_(scn.world.image, scn.seed, scn.uavs[uav].name) {}
 
+double CameraImaging::exposure() const {
+  return sensor_.physical() ? sensor_.next().exposure_s : scn_.uavs[uav_].camera.shutter.exposure;
+}
+
 bool CameraImaging::instant() const {
   const auto& s = scn_.uavs[uav_].camera.shutter;
-  return !s.rolling() && !(s.blurs() || (sensor_.physical() && s.subframes > 1));
+  return !s.rolling() && (exposure() == 0 || s.subframes == 1);
 }
 
 TakenFrame CameraImaging::take(const sim::Truth& truth, double t, const Draw& draw) {
   const sim::ShutterSpec& shutter = scn_.uavs[uav_].camera.shutter;
   const sim::KinematicState k = truth.camera(uav_, t);
   TakenFrame out;
-  // The sensor's exposure (auto-exposure's) when it is physical; the shutter's otherwise.
-  const double exposure = sensor_.physical() ? sensor_.next().exposure_s : shutter.exposure;
-  out.frame = render::expose(shutter, exposure, model_.width(), model_.height(), [&](double dt, int row0, int rows) {
+  out.frame = render::expose(shutter, exposure(), model_.width(), model_.height(), [&](double dt, int row0, int rows) {
     return draw({model_, pose_after(truth, uav_, t, k, dt), t + dt}, sim::lead_pose(truth, t + dt, scn_.world), row0,
                 rows);
   });

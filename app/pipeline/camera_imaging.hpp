@@ -51,6 +51,10 @@ class CameraImaging {
   bool instant() const;
 
  private:
+  // The next frame's exposure time: the sensor's (auto-exposure's) when it is physical, the
+  // shutter's otherwise.
+  double exposure() const;
+
   const sim::Scenario& scn_;
   int uav_;
   geometry::PinholeCamera model_;
