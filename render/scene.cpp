@@ -101,7 +101,7 @@ cv::Mat procedural_ground(const sim::TextureSpec& t, std::uint64_t seed) {
   return out;
 }
 
-// Cloud density over a period of 8 cloud scales: periodic noise at 8 and 16 cells a period (clouds
+// Cloud density over a period of 8 cloud scales: periodic noise at 8, 16 and 32 cells a period (clouds
 // of about `scale` metres, with ragged edges), thresholded at the quantile that covers `cover` of
 // the sky with an edge `softness` wide in that quantile.
 cv::Mat cloud_field(const sim::CloudSpec& c, std::uint64_t seed) {
