@@ -162,6 +162,8 @@ FrameKeyer::FrameKeyer(const Scene& scene, std::string_view salt) {
   for (const Material& m : scene.materials) {
     hash_mat(s.get(), m.texture);
     hash_doubles(s.get(), {double(m.repeat), double(m.mipmaps), m.anisotropy, double(m.trilinear), double(m.unlit)});
+    if (m.stochastic_cell > 0)  // hashed only when on
+      hash_doubles(s.get(), {m.stochastic_cell, m.blend_sharpness, double(m.stochastic_seed)});
   }
   for (const auto* meshes : {&scene.static_meshes, &scene.lead_meshes}) {
     hash_doubles(s.get(), {double(meshes->size())});
@@ -178,6 +180,8 @@ FrameKeyer::FrameKeyer(const Scene& scene, std::string_view salt) {
   hash_doubles(s.get(), {l.direction.x(), l.direction.y(), l.direction.z(), l.ambient, l.diffuse, scene.sky.x(),
                          scene.sky.y(), scene.sky.z(), scene.near, scene.far, double(scene.msaa)});
   if (l.shadows) hash_doubles(s.get(), {1.0, double(l.shadow_map)});  // hashed only when on
+  if (l.skylight.model != sim::SkylightSpec::Model::Constant)
+    hash_doubles(s.get(), {2.0, l.skylight.ground_albedo, l.skylight.aerosol_depth});
   timed_ = !scene.clouds.empty();
   if (timed_) {
     const sim::CloudSpec& c = l.clouds;

@@ -5,11 +5,13 @@
 
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "render/gl_functions.hpp"
+#include "render/skylight.hpp"
 
 namespace wingman::render {
 
@@ -18,8 +20,9 @@ namespace {
 // Lambert shading per vertex: the terrain's normals vary smoothly over its 2 m cells and the
 // objects are flat-shaded, so per-pixel lighting changed nothing visible, while llvmpipe's
 // fragment cost grows with every varying and instruction. The fragment shader is one texture
-// lookup times one colour.
-const char* kSceneVs = R"(#version 330 core
+// lookup times one colour. The light besides the sun's beam runs from u_bounce (a surface facing
+// down) to u_ambient (facing up); they are equal under the constant sky (render/skylight.hpp).
+const char* kSceneVs = R"(
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
@@ -28,27 +31,28 @@ uniform mat4 u_model_view;
 uniform mat4 u_proj;
 uniform mat3 u_model_rot;
 uniform vec3 u_to_light;
-uniform float u_ambient;
-uniform float u_diffuse;
+uniform vec3 u_ambient;
+uniform vec3 u_bounce;
+uniform vec3 u_diffuse;
 uniform bool u_unlit;
 out vec2 v_uv;
 out vec3 v_colour;
 void main() {
-  float shade = u_unlit ? 1.0
-      : u_ambient + u_diffuse * max(dot(normalize(u_model_rot * a_normal), u_to_light), 0.0);
+  vec3 n = normalize(u_model_rot * a_normal);
+  vec3 shade = u_unlit ? vec3(1.0)
+      : u_bounce + (u_ambient - u_bounce) * (0.5 + 0.5 * n.z) + u_diffuse * max(dot(n, u_to_light), 0.0);
   v_uv = a_uv;
   v_colour = a_colour * shade;
   gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
 }
 )";
 
-const char* kSceneFs = R"(#version 330 core
+const char* kSceneFs = R"(
 in vec2 v_uv;
 in vec3 v_colour;
-uniform sampler2D u_tex;
 layout(location = 0) out vec4 o_colour;
 void main() {
-  o_colour = vec4(texture(u_tex, v_uv).rgb * v_colour, 1.0);
+  o_colour = vec4(surface(v_uv) * v_colour, 1.0);
 }
 )";
 
@@ -56,7 +60,7 @@ void main() {
 // vertex, and the diffuse one scaled per pixel by what the shadow map lets through (2x2
 // percentage-closer filtering by the sampler's compare mode). A program of its own, so that a
 // world without shadows runs exactly the programs above.
-const char* kShadowedVs = R"(#version 330 core
+const char* kShadowedVs = R"(
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
@@ -67,8 +71,9 @@ uniform mat3 u_model_rot;
 uniform mat4 u_light_from_model;
 uniform mat4 u_model;
 uniform vec3 u_to_light;
-uniform float u_ambient;
-uniform float u_diffuse;
+uniform vec3 u_ambient;
+uniform vec3 u_bounce;
+uniform vec3 u_diffuse;
 uniform bool u_unlit;
 uniform vec2 u_cloud_offset;  // m the clouds have drifted
 uniform float u_cloud_period;  // m the cloud texture spans
@@ -82,22 +87,22 @@ void main() {
   // Where the ray to the sun crosses the cloud layer.
   vec3 p = (u_model * vec4(a_pos, 1.0)).xyz;
   v_cloud = (p.xy + u_to_light.xy * (u_cloud_height - p.z) / max(u_to_light.z, 0.05) - u_cloud_offset) / u_cloud_period;
-  float direct = u_unlit ? 0.0 : u_diffuse * max(dot(normalize(u_model_rot * a_normal), u_to_light), 0.0);
+  vec3 n = normalize(u_model_rot * a_normal);
+  vec3 direct = u_unlit ? vec3(0.0) : u_diffuse * max(dot(n, u_to_light), 0.0);
   v_uv = a_uv;
-  v_ambient = a_colour * (u_unlit ? 1.0 : u_ambient);
+  v_ambient = a_colour * (u_unlit ? vec3(1.0) : u_bounce + (u_ambient - u_bounce) * (0.5 + 0.5 * n.z));
   v_direct = a_colour * direct;
   v_light = u_light_from_model * vec4(a_pos, 1.0);
   gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
 }
 )";
 
-const char* kShadowedFs = R"(#version 330 core
+const char* kShadowedFs = R"(
 in vec2 v_uv;
 in vec3 v_ambient;
 in vec3 v_direct;
 in vec4 v_light;
 in vec2 v_cloud;
-uniform sampler2D u_tex;
 uniform sampler2DShadow u_shadow;
 uniform sampler2D u_clouds;
 uniform bool u_zero_to_one;
@@ -107,7 +112,77 @@ void main() {
   vec3 p = v_light.xyz / v_light.w;
   float lit = texture(u_shadow, vec3(p.xy * 0.5 + 0.5, u_zero_to_one ? p.z : p.z * 0.5 + 0.5));
   lit *= 1.0 - u_cloud_block * texture(u_clouds, v_cloud).r;
-  o_colour = vec4(texture(u_tex, v_uv).rgb * (v_ambient + lit * v_direct), 1.0);
+  o_colour = vec4(surface(v_uv) * (v_ambient + lit * v_direct), 1.0);
+}
+)";
+
+// A surface's colour at texture coordinate uv: the texture as it is.
+const char* kImageLookup = R"(
+uniform sampler2D u_tex;
+vec3 surface(vec2 uv) { return texture(u_tex, uv).rgb; }
+)";
+
+// Stochastic tiling (world.texture.tiling; Heitz & Neyret 2018, in the form of Deliot & Heitz
+// 2019): an equilateral triangle grid over the texture's plane; each grid vertex shows the piece
+// of the image around a centre drawn for it (an integer hash, the same on every GL), kept at least
+// a cell from the image's border so that no piece ever wraps over a seam; each pixel blends the
+// three pieces of its triangle with sharpened barycentric weights, about the image's mean and
+// divided by the weights' norm so that the blend keeps the image's variance. The gradients of the
+// plain coordinate pick the mipmap level (each piece is the same coordinate shifted).
+const char* kStochasticLookup = R"(
+uniform sampler2D u_tex;
+uniform float u_cell;       // grid side, in units of the texture's width
+uniform float u_aspect;     // the texture's height over its width
+uniform float u_sharpness;  // power of the blend weights
+uniform vec3 u_mean;        // the image's mean colour
+uniform uint u_seed;
+uvec2 pcg2d(uvec2 v) {
+  v = v * 1664525u + 1013904223u;
+  v.x += v.y * 1664525u;
+  v.y += v.x * 1664525u;
+  v = v ^ (v >> 16u);
+  v.x += v.y * 1664525u;
+  v.y += v.x * 1664525u;
+  v = v ^ (v >> 16u);
+  return v;
+}
+// The shift from the coordinate of vertex `id` to where its piece lies in the image.
+vec2 piece_shift(ivec2 id) {
+  vec2 r = vec2(pcg2d(uvec2(id) + uvec2(u_seed, 3u * u_seed + 1u)) >> 8u) / 16777216.0;
+  float lo = u_cell * 1.02;
+  vec2 centre = vec2(lo) + r * (vec2(1.0, u_aspect) - 2.0 * vec2(lo));
+  vec2 at = u_cell * vec2(float(id.x) + 0.5 * float(id.y), 0.8660254 * float(id.y));
+  return centre - at;
+}
+// The lattice's three-colouring: each triangle has one vertex of each colour.
+int colour(ivec2 id) { return (id.x + 2 * id.y + 3000000) % 3; }
+vec3 surface(vec2 uv) {
+  vec2 dx = dFdx(uv), dy = dFdy(uv);
+  vec2 q = vec2(uv.x, uv.y * u_aspect);
+  vec2 g = mat2(1.0, 0.0, -0.57735027, 1.15470054) * (q / u_cell);
+  ivec2 base = ivec2(floor(g));
+  vec2 f = g - floor(g);
+  float z = 1.0 - f.x - f.y;
+  bool lower = z > 0.0;
+  // The triangle's vertices and weights, each in the slot of its colour: across an edge the two
+  // shared vertices keep their slots, so each lookup's coordinate jumps only where its weight is
+  // nought (a 2x2 quad of pixels never filters one lookup from far-apart pieces).
+  ivec2 id[3];
+  vec3 w;
+  ivec2 a = lower ? base : base + ivec2(1, 1), b = base + ivec2(1, 0), c = base + ivec2(0, 1);
+  id[colour(a)] = a;
+  id[colour(b)] = b;
+  id[colour(c)] = c;
+  w[colour(a)] = lower ? z : -z;
+  w[colour(b)] = lower ? f.x : 1.0 - f.y;
+  w[colour(c)] = lower ? f.y : 1.0 - f.x;
+  w = pow(max(w, vec3(1e-4)), vec3(u_sharpness));  // pow(0, k) is undefined under fast math
+  w /= w.x + w.y + w.z;
+  vec2 s = vec2(1.0, 1.0 / u_aspect);
+  vec3 sum = vec3(0.0);
+  for (int k = 0; k < 3; ++k)
+    sum += w[k] * (textureGrad(u_tex, uv + piece_shift(id[k]) * s, dx, dy).rgb - u_mean);
+  return clamp(sum / sqrt(dot(w, w)) + u_mean, 0.0, 1.0);
 }
 )";
 
@@ -115,7 +190,7 @@ void main() {
 // program (no colour, no texture): the surface at the pixel centre, exactly as without MSAA, never
 // a blend of two surfaces at an edge. Colour is resolved by glBlitFramebuffer. On llvmpipe this
 // costs 12 ms less than one resolve shader averaging the colour samples and picking a depth.
-const char* kDepthVs = R"(#version 330 core
+const char* kDepthVs = R"(
 layout(location = 0) in vec3 a_pos;
 uniform mat4 u_model_view;
 uniform mat4 u_proj;
@@ -124,7 +199,7 @@ void main() {
 }
 )";
 
-const char* kDepthFs = R"(#version 330 core
+const char* kDepthFs = R"(
 void main() {}
 )";
 
@@ -192,6 +267,20 @@ bool in_view(const Eigen::AlignedBox3f& box, const Eigen::Matrix4f& clip_from_wo
 struct GpuMaterial {
   GLuint tex = 0;
   bool unlit = false;
+  // Stochastic tiling (kStochasticLookup); cell 0: the texture as it is.
+  float cell = 0, aspect = 1, sharpness = 1;
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  GLuint seed = 0;
+};
+
+// The uniform locations of one colour program; -1 for those it lacks (glUniform ignores them).
+struct ColourProgram {
+  GLuint id = 0;
+  GLint model_view = -1, proj = -1, model_rot = -1, tex = -1, to_light = -1, ambient = -1, bounce = -1,
+        diffuse = -1, unlit = -1;
+  GLint light_from_model = -1, shadow = -1, zero_to_one = -1, model = -1, cloud_tex = -1, cloud_offset = -1,
+        cloud_period = -1, cloud_height = -1, cloud_block = -1;
+  GLint cell = -1, aspect = -1, sharpness = -1, mean = -1, seed = -1;
 };
 
 struct Target {
@@ -245,16 +334,14 @@ cv::Mat Frame::gray() const {
 
 struct Renderer::Impl {
   GlFunctions gl;
-  GLuint program = 0, depth_program = 0, white = 0;
-  GLint u_model_view = -1, u_proj = -1, u_model_rot = -1, u_tex = -1, u_to_light = -1,
-        u_ambient = -1, u_diffuse = -1, u_unlit = -1;
+  GLuint depth_program = 0, white = 0;
   GLint d_model_view = -1, d_proj = -1;
-  // The shadowed colour program (kShadowedVs/Fs) and the shadow map, when the world has shadows.
+  // The colour programs by [shadowed][stochastic]; id 0 where the scene needs none.
+  ColourProgram colour[2][2];
+  SkyLight sky;
+  // The shadow map and the cloud texture, when the world has shadows.
   struct Shadowed {
-    GLuint program = 0, fbo = 0, map = 0, clouds = 0;
-    GLint model_view = -1, proj = -1, model_rot = -1, tex = -1, to_light = -1, ambient = -1, diffuse = -1,
-          unlit = -1, light_from_model = -1, shadow = -1, zero_to_one = -1, model = -1, cloud_tex = -1,
-          cloud_offset = -1, cloud_period = -1, cloud_height = -1, cloud_block = -1;
+    GLuint fbo = 0, map = 0, clouds = 0;
     double time = 0;  // s of the frame being drawn
   } sh;
   std::vector<GpuMaterial> materials;
@@ -266,9 +353,12 @@ struct Renderer::Impl {
   float max_aniso = 1;
   DepthMap depth;  // reversed-Z where the context has glClipControl
 
-  GLuint compile(GLenum type, const char* src) {
+  // Every source is the version line and the parts given, in order.
+  GLuint compile(GLenum type, std::initializer_list<const char*> parts) {
+    std::vector<const char*> src{"#version 330 core\n"};
+    src.insert(src.end(), parts.begin(), parts.end());
     GLuint s = gl.CreateShader(type);
-    gl.ShaderSource(s, 1, &src, nullptr);
+    gl.ShaderSource(s, static_cast<GLsizei>(src.size()), src.data(), nullptr);
     gl.CompileShader(s);
     GLint ok = 0;
     gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
@@ -279,7 +369,7 @@ struct Renderer::Impl {
     }
     return s;
   }
-  GLuint link(const char* vs, const char* fs) {
+  GLuint link(std::initializer_list<const char*> vs, std::initializer_list<const char*> fs) {
     GLuint p = gl.CreateProgram();
     GLuint a = compile(GL_VERTEX_SHADER, vs), b = compile(GL_FRAGMENT_SHADER, fs);
     gl.AttachShader(p, a);
@@ -328,6 +418,21 @@ struct Renderer::Impl {
       gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     }
     return t;
+  }
+
+  GpuMaterial upload_material(const Material& m) {
+    GpuMaterial g;
+    g.tex = m.texture.empty() ? 0 : upload_texture(m.texture, m.repeat, m.mipmaps, m.trilinear, m.anisotropy);
+    g.unlit = m.unlit;
+    if (m.stochastic_cell > 0 && !m.texture.empty()) {
+      g.aspect = static_cast<float>(m.texture.rows) / static_cast<float>(m.texture.cols);
+      g.cell = static_cast<float>(m.stochastic_cell * std::min(1.0f, g.aspect));
+      g.sharpness = static_cast<float>(m.blend_sharpness);
+      const cv::Scalar mean = cv::mean(m.texture);
+      g.mean = Eigen::Vector3f(mean[0], mean[1], mean[2]) / 255.f;
+      g.seed = m.stochastic_seed;
+    }
+    return g;
   }
 
   // cell: chunk size in metres; 0 for one chunk (the lead, which moves).
@@ -399,63 +504,94 @@ struct Renderer::Impl {
   }
 
   // The scene from view V: textured and lit (colour), or positions only (depth pass). light: the
-  // sun's clip space from the world, for the shadowed colour program; null for the plain one.
+  // sun's clip space from the world, for the shadowed colour programs; null for the plain ones.
   void draw_scene(bool colour, const Eigen::Matrix4f& P, const Eigen::Matrix4d& V,
                   const std::optional<Eigen::Matrix4d>& lead_model, const Eigen::Matrix4f* light = nullptr) {
-    const bool shadowed = colour && light;
-    gl.UseProgram(shadowed ? sh.program : colour ? program : depth_program);
-    gl.UniformMatrix4fv(shadowed ? sh.proj : colour ? u_proj : d_proj, 1, GL_FALSE, P.data());
-    if (colour) {
-      const Eigen::Vector3f to_light = (-info.light.direction.normalized()).cast<float>();
-      gl.Uniform3fv(shadowed ? sh.to_light : u_to_light, 1, to_light.data());
-      gl.Uniform1f(shadowed ? sh.ambient : u_ambient, static_cast<float>(info.light.ambient));
-      gl.Uniform1f(shadowed ? sh.diffuse : u_diffuse, static_cast<float>(info.light.diffuse));
-      gl.Uniform1i(shadowed ? sh.tex : u_tex, 0);
-      if (shadowed) {
-        gl.Uniform1i(sh.shadow, 1);
-        gl.Uniform1i(sh.zero_to_one, depth.reversed ? 1 : 0);
-        gl.ActiveTexture(GL_TEXTURE1);
-        gl.BindTexture(GL_TEXTURE_2D, sh.map);
-        const sim::CloudSpec& c = info.light.clouds;
-        const Eigen::Vector2f drift = (c.wind.head<2>() * sh.time).cast<float>();
-        gl.Uniform1i(sh.cloud_tex, 2);
-        gl.Uniform2fv(sh.cloud_offset, 1, drift.data());
-        gl.Uniform1f(sh.cloud_period, static_cast<float>(8 * c.scale));
-        gl.Uniform1f(sh.cloud_height, static_cast<float>(c.height));
-        gl.Uniform1f(sh.cloud_block, sh.clouds ? static_cast<float>(1 - c.transmission) : 0.f);
-        gl.ActiveTexture(GL_TEXTURE2);
-        gl.BindTexture(GL_TEXTURE_2D, sh.clouds ? sh.clouds : white);
-      }
+    if (colour && light) {
+      gl.ActiveTexture(GL_TEXTURE1);
+      gl.BindTexture(GL_TEXTURE_2D, sh.map);
+      gl.ActiveTexture(GL_TEXTURE2);
+      gl.BindTexture(GL_TEXTURE_2D, sh.clouds ? sh.clouds : white);
       gl.ActiveTexture(GL_TEXTURE0);
     }
-    draw_meshes(colour, static_meshes, P, V, Eigen::Matrix4d::Identity(), light);
-    if (lead_model) draw_meshes(colour, lead_meshes, P, V, *lead_model, light);
+    const Pass pass{colour, P, V, light};
+    draw_meshes(pass, static_meshes, Eigen::Matrix4d::Identity());
+    if (lead_model) draw_meshes(pass, lead_meshes, *lead_model);
   }
 
-  void draw_meshes(bool colour, const std::vector<GpuMesh>& meshes, const Eigen::Matrix4f& P,
-                   const Eigen::Matrix4d& V, const Eigen::Matrix4d& M, const Eigen::Matrix4f* light = nullptr) {
-    const bool shadowed = colour && light;
-    const Eigen::Matrix4f MV = to_float(V * M);
-    const Eigen::Matrix4f clip_from_model = P * MV;
-    gl.UniformMatrix4fv(shadowed ? sh.model_view : colour ? u_model_view : d_model_view, 1, GL_FALSE, MV.data());
-    if (colour) {
-      const Eigen::Matrix3f R = M.topLeftCorner<3, 3>().cast<float>();
-      gl.UniformMatrix3fv(shadowed ? sh.model_rot : u_model_rot, 1, GL_FALSE, R.data());
+  struct Pass {
+    bool colour;
+    const Eigen::Matrix4f& P;
+    const Eigen::Matrix4d& V;
+    const Eigen::Matrix4f* light;
+  };
+
+  // Makes p current with the pass's and the model M's uniforms.
+  void use(const ColourProgram& p, const Pass& pass, const Eigen::Matrix4d& M) {
+    gl.UseProgram(p.id);
+    const Eigen::Matrix4f MV = to_float(pass.V * M);
+    const Eigen::Matrix3f R = M.topLeftCorner<3, 3>().cast<float>();
+    gl.UniformMatrix4fv(p.proj, 1, GL_FALSE, pass.P.data());
+    gl.UniformMatrix4fv(p.model_view, 1, GL_FALSE, MV.data());
+    gl.UniformMatrix3fv(p.model_rot, 1, GL_FALSE, R.data());
+    const Eigen::Vector3f to_light = (-info.light.direction.normalized()).cast<float>();
+    const Eigen::Vector3f ambient = sky.sky.cast<float>(), bounce = sky.ground.cast<float>(),
+                          diffuse = sky.beam.cast<float>();
+    gl.Uniform3fv(p.to_light, 1, to_light.data());
+    gl.Uniform3fv(p.ambient, 1, ambient.data());
+    gl.Uniform3fv(p.bounce, 1, bounce.data());
+    gl.Uniform3fv(p.diffuse, 1, diffuse.data());
+    gl.Uniform1i(p.tex, 0);
+    if (!pass.light) return;
+    const Eigen::Matrix4f L = *pass.light * to_float(M), Mf = to_float(M);
+    gl.UniformMatrix4fv(p.light_from_model, 1, GL_FALSE, L.data());
+    gl.UniformMatrix4fv(p.model, 1, GL_FALSE, Mf.data());
+    gl.Uniform1i(p.shadow, 1);
+    gl.Uniform1i(p.zero_to_one, depth.reversed ? 1 : 0);
+    const sim::CloudSpec& c = info.light.clouds;
+    const Eigen::Vector2f drift = (c.wind.head<2>() * sh.time).cast<float>();
+    gl.Uniform1i(p.cloud_tex, 2);
+    gl.Uniform2fv(p.cloud_offset, 1, drift.data());
+    gl.Uniform1f(p.cloud_period, static_cast<float>(8 * c.scale));
+    gl.Uniform1f(p.cloud_height, static_cast<float>(c.height));
+    gl.Uniform1f(p.cloud_block, sh.clouds ? static_cast<float>(1 - c.transmission) : 0.f);
+  }
+
+  // Binds a mesh's material to the colour program that draws it (made current first when another
+  // one is).
+  void bind_material(const GpuMaterial* mat, const Pass& pass, const Eigen::Matrix4d& M,
+                     const ColourProgram*& current) {
+    const ColourProgram& p = colour[pass.light ? 1 : 0][mat && mat->cell > 0 ? 1 : 0];
+    if (&p != current) use(p, pass, M);
+    current = &p;
+    gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : white);
+    gl.Uniform1i(p.unlit, mat && mat->unlit ? 1 : 0);
+    if (mat && mat->cell > 0) {
+      gl.Uniform1f(p.cell, mat->cell);
+      gl.Uniform1f(p.aspect, mat->aspect);
+      gl.Uniform1f(p.sharpness, mat->sharpness);
+      gl.Uniform3fv(p.mean, 1, mat->mean.data());
+      gl.Uniform1ui(p.seed, mat->seed);
     }
-    if (shadowed) {
-      const Eigen::Matrix4f L = *light * to_float(M), Mf = to_float(M);
-      gl.UniformMatrix4fv(sh.light_from_model, 1, GL_FALSE, L.data());
-      gl.UniformMatrix4fv(sh.model, 1, GL_FALSE, Mf.data());
+  }
+
+  void draw_meshes(const Pass& pass, const std::vector<GpuMesh>& meshes, const Eigen::Matrix4d& M) {
+    const Eigen::Matrix4f clip_from_model = pass.P * to_float(pass.V * M);
+    const ColourProgram* current = nullptr;
+    if (!pass.colour) {
+      const Eigen::Matrix4f MV = to_float(pass.V * M);
+      gl.UseProgram(depth_program);
+      gl.UniformMatrix4fv(d_proj, 1, GL_FALSE, pass.P.data());
+      gl.UniformMatrix4fv(d_model_view, 1, GL_FALSE, MV.data());
     }
     for (const auto& m : meshes) {
-      if (colour) {
-        const GpuMaterial* mat = m.material >= 0 ? &materials[m.material] : nullptr;
-        gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : white);
-        gl.Uniform1i(shadowed ? sh.unlit : u_unlit, mat && mat->unlit ? 1 : 0);
-      }
+      if (pass.colour) bind_material(m.material >= 0 ? &materials[m.material] : nullptr, pass, M, current);
       draw_visible(m, clip_from_model);
     }
   }
+
+  // The colour program of one [shadowed][stochastic] pair, with its uniform locations.
+  ColourProgram make_colour_program(bool shadowed, bool stochastic);
 
   void setup_shadows(int size, const cv::Mat& clouds);
   Eigen::Matrix4f render_shadow_map(const Eigen::Matrix4f& clip_from_world,
@@ -516,28 +652,37 @@ struct Renderer::Impl {
       }
     for (auto& m : materials) gl.DeleteTextures(1, &m.tex);
     gl.DeleteTextures(1, &white);
-    gl.DeleteProgram(program);
+    for (auto& row : colour)
+      for (auto& p : row)
+        if (p.id) gl.DeleteProgram(p.id);
     gl.DeleteProgram(depth_program);
-    if (sh.program) {
+    if (sh.map) {
       if (sh.clouds) gl.DeleteTextures(1, &sh.clouds);
-      gl.DeleteProgram(sh.program);
       gl.DeleteFramebuffers(1, &sh.fbo);
       gl.DeleteTextures(1, &sh.map);
     }
   }
 };
 
+ColourProgram Renderer::Impl::make_colour_program(bool shadowed, bool stochastic) {
+  ColourProgram p;
+  const char* lookup = stochastic ? kStochasticLookup : kImageLookup;
+  p.id = shadowed ? link({kShadowedVs}, {lookup, kShadowedFs}) : link({kSceneVs}, {lookup, kSceneFs});
+  for (auto [loc, name] : {std::pair{&p.model_view, "u_model_view"}, {&p.proj, "u_proj"}, {&p.model_rot, "u_model_rot"},
+                           {&p.tex, "u_tex"}, {&p.to_light, "u_to_light"}, {&p.ambient, "u_ambient"},
+                           {&p.bounce, "u_bounce"}, {&p.diffuse, "u_diffuse"}, {&p.unlit, "u_unlit"},
+                           {&p.light_from_model, "u_light_from_model"}, {&p.shadow, "u_shadow"},
+                           {&p.zero_to_one, "u_zero_to_one"}, {&p.model, "u_model"}, {&p.cloud_tex, "u_clouds"},
+                           {&p.cloud_offset, "u_cloud_offset"}, {&p.cloud_period, "u_cloud_period"},
+                           {&p.cloud_height, "u_cloud_height"}, {&p.cloud_block, "u_cloud_block"},
+                           {&p.cell, "u_cell"}, {&p.aspect, "u_aspect"}, {&p.sharpness, "u_sharpness"},
+                           {&p.mean, "u_mean"}, {&p.seed, "u_seed"}})
+    *loc = gl.GetUniformLocation(p.id, name);
+  return p;
+}
+
 void Renderer::Impl::setup_shadows(int size, const cv::Mat& clouds) {
   if (!clouds.empty()) sh.clouds = upload_texture(clouds, true, true, true, 1);
-  sh.program = link(kShadowedVs, kShadowedFs);
-  for (auto [loc, name] : {std::pair{&sh.model_view, "u_model_view"}, {&sh.proj, "u_proj"}, {&sh.model_rot, "u_model_rot"},
-                           {&sh.tex, "u_tex"}, {&sh.to_light, "u_to_light"}, {&sh.ambient, "u_ambient"},
-                           {&sh.diffuse, "u_diffuse"}, {&sh.unlit, "u_unlit"}, {&sh.light_from_model, "u_light_from_model"},
-                           {&sh.shadow, "u_shadow"}, {&sh.zero_to_one, "u_zero_to_one"}, {&sh.model, "u_model"},
-                           {&sh.cloud_tex, "u_clouds"}, {&sh.cloud_offset, "u_cloud_offset"},
-                           {&sh.cloud_period, "u_cloud_period"}, {&sh.cloud_height, "u_cloud_height"},
-                           {&sh.cloud_block, "u_cloud_block"}})
-    *loc = gl.GetUniformLocation(sh.program, name);
   gl.GenTextures(1, &sh.map);
   gl.BindTexture(GL_TEXTURE_2D, sh.map);
   gl.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, size, size, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
@@ -623,28 +768,22 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.info.far = scene.far;
   I.info.msaa = scene.msaa;
   I.depth = depth_map(scene.near, scene.far, gl.ClipControl != nullptr);
-  I.program = I.link(kSceneVs, kSceneFs);
-  I.depth_program = I.link(kDepthVs, kDepthFs);
-  I.u_model_view = gl.GetUniformLocation(I.program, "u_model_view");
-  I.u_proj = gl.GetUniformLocation(I.program, "u_proj");
-  I.u_model_rot = gl.GetUniformLocation(I.program, "u_model_rot");
-  I.u_tex = gl.GetUniformLocation(I.program, "u_tex");
-  I.u_to_light = gl.GetUniformLocation(I.program, "u_to_light");
-  I.u_ambient = gl.GetUniformLocation(I.program, "u_ambient");
-  I.u_diffuse = gl.GetUniformLocation(I.program, "u_diffuse");
-  I.u_unlit = gl.GetUniformLocation(I.program, "u_unlit");
+  I.sky = sky_light(scene.light, scene.light.direction);
+  I.depth_program = I.link({kDepthVs}, {kDepthFs});
   I.d_model_view = gl.GetUniformLocation(I.depth_program, "u_model_view");
   I.d_proj = gl.GetUniformLocation(I.depth_program, "u_proj");
   if (scene.light.shadows) I.setup_shadows(scene.light.shadow_map, scene.clouds);
   I.white =
       I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, false, 1);
+  bool stochastic = false;
   for (const auto& m : scene.materials) {
-    GpuMaterial g;
-    g.tex = m.texture.empty() ? 0 : I.upload_texture(m.texture, m.repeat, m.mipmaps, m.trilinear,
-                                                         m.anisotropy);
-    g.unlit = m.unlit;
-    I.materials.push_back(g);
+    I.materials.push_back(I.upload_material(m));
+    stochastic = stochastic || I.materials.back().cell > 0;
   }
+  for (int shadowed = 0; shadowed < 2; ++shadowed)
+    for (int st = 0; st < 2; ++st)
+      if ((!shadowed || scene.light.shadows) && (!st || stochastic))
+        I.colour[shadowed][st] = I.make_colour_program(shadowed, st);
   for (const auto& m : scene.static_meshes)
     if (!m.indices.empty()) I.static_meshes.push_back(I.upload_mesh(m, kChunkSize));
   for (const auto& m : scene.lead_meshes)
@@ -703,7 +842,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   std::optional<Eigen::Matrix4f> light;
   I.sh.time = view.time;
-  if (I.sh.program) light = I.render_shadow_map(P * to_float(V), lead_model);
+  if (I.sh.map) light = I.render_shadow_map(P * to_float(V), lead_model);
   gl.Viewport(0, 0, w, h);
   gl.Enable(GL_DEPTH_TEST);
   gl.DepthFunc(I.depth.reversed ? GL_GREATER : GL_LESS);

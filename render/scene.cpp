@@ -439,6 +439,18 @@ void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, co
   scene.lead_meshes.push_back(std::move(q));
 }
 
+namespace {
+
+void stochastic_tiling(const sim::TextureSpec& t, std::uint64_t seed, Material& m) {
+  if (t.tiling != sim::TextureSpec::Tiling::Stochastic) return;
+  m.stochastic_cell = t.cell;
+  m.blend_sharpness = t.blend_sharpness;
+  auto rng = sim::make_stream(seed, "ground_tiling");
+  m.stochastic_seed = static_cast<std::uint32_t>(rng());
+}
+
+}  // namespace
+
 Scene build_scene(const sim::WorldDescription& world) {
   const sim::WorldSpec& w = world.spec;
   Scene scene;
@@ -458,11 +470,13 @@ Scene build_scene(const sim::WorldDescription& world) {
     const std::string p = sim::resolve_asset(w.texture.image, world.scenario_path, "ground texture");
     ground.texture = read_image_rgb(p, "ground texture");
     ground.repeat = w.texture.mode == sim::TextureSpec::Mode::Tiled;
+    if (ground.repeat) stochastic_tiling(w.texture, world.seed, ground);
     // Keep the image's aspect ratio: tile_size is its width.
     tex_h = tex_w * ground.texture.rows / ground.texture.cols;
   } else {
     ground.texture = procedural_ground(w.texture, world.seed);
     tex_w = tex_h = w.texture.size * w.texture.detail_min;
+    stochastic_tiling(w.texture, world.seed, ground);
   }
   scene.materials.push_back(ground);
   scene.static_meshes.push_back(terrain_mesh(w, world.terrain, 0, tex_w, tex_h));

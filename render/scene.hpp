@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,11 @@ struct Material {
   double anisotropy = 4;
   bool trilinear = true;  // between mipmap levels; false: the nearest level only (faster)
   bool unlit = false;  // colour shown as is (markers, test targets)
+  // Stochastic tiling (world.texture.tiling, render/renderer.cpp kStochasticLookup): the triangle
+  // grid's side as a fraction of the texture's shorter side; 0: the texture as it is.
+  double stochastic_cell = 0;
+  double blend_sharpness = 8;
+  std::uint32_t stochastic_seed = 0;
 };
 
 struct Mesh {

@@ -44,6 +44,7 @@ struct TextureSpec {
   enum class Type { Image, Procedural };
   enum class Mode { Tiled, Stretched };
   enum class Filter { Trilinear, Bilinear };
+  enum class Tiling { Stochastic, Repeat };
   Type type = Type::Image;
   std::string image = "aerial/freetown_drone_nadir.jpg";  // scenario dir, then assets/
   Mode mode = Mode::Tiled;
@@ -51,6 +52,16 @@ struct TextureSpec {
   // m: the world point of one copy's top-left corner (tiled), so that a flight can lie inside one
   // copy of a large image and see no repetition.
   double origin_x = 0, origin_y = 0;
+  // How a tiled texture fills a world larger than one copy (docs/rendering.md, Ground): stochastic
+  // lays a triangle grid over the ground and shows at each of its vertices a piece of the image
+  // from a place drawn for that vertex, blended across the cells with the image's variance kept
+  // (Heitz & Neyret 2018), so that no copy, lattice or seam of the image repeats; repeat tiles the
+  // image as it is. `cell`: the grid's side as a fraction of the image's shorter side;
+  // `blend_sharpness`: the power of the blend weights (1: linear blend; higher: narrower
+  // transitions, most of the ground one piece of the photo at a time).
+  Tiling tiling = Tiling::Stochastic;
+  double cell = 0.25;
+  double blend_sharpness = 8;
   double detail_min = 0.02;  // m, finest and coarsest detail of the procedural texture
   double detail_max = 0.2;
   int size = 2048;           // px of the procedural texture (one tile, detail_min per texel)
@@ -72,6 +83,9 @@ struct TextureSpec {
     v("tile_size", tile_size, geometry::gt(0));
     v("origin_x", origin_x);
     v("origin_y", origin_y);
+    v.choice("tiling", tiling, {{"stochastic", Tiling::Stochastic}, {"repeat", Tiling::Repeat}});
+    v("cell", cell, geometry::in(0.05, 0.45));
+    v("blend_sharpness", blend_sharpness, geometry::in(1, 64));
     v("detail_min", detail_min, geometry::gt(0));
     v("detail_max", detail_max, geometry::gt(0));
     v.check("detail_max", detail_max >= detail_min, "must be at least detail_min");
@@ -162,6 +176,26 @@ struct CloudSpec {
   }
 };
 
+// Light from the sky and the ground besides the sun's beam (docs/rendering.md, Light). constant:
+// `ambient` and `diffuse` as given, white, on every surface alike. clear_sky: both follow the sun's
+// elevation through a clear atmosphere (render/skylight.hpp): the beam dims and reddens with the
+// air mass, the sky light dims and stays blue, and a surface sees the sky over the part of its
+// hemisphere facing up and the ground (of `ground_albedo`) over the rest; `ambient` and `diffuse`
+// are then their values for the sun at the zenith.
+struct SkylightSpec {
+  enum class Model { Constant, ClearSky };
+  Model model = Model::Constant;
+  double ground_albedo = 0.15;
+  double aerosol_depth = 0.1;  // aerosol optical depth at 550 nm (0.05 very clear, 0.3 hazy)
+
+  template <class V>
+  void visit(V& v) {
+    v.choice("model", model, {{"constant", Model::Constant}, {"clear_sky", Model::ClearSky}});
+    v("ground_albedo", ground_albedo, geometry::in(0, 1));
+    v("aerosol_depth", aerosol_depth, geometry::in(0, 2));
+  }
+};
+
 struct LightSpec {
   Eigen::Vector3d direction{-0.4, 0.3, -1.0};  // world frame, the way the light travels
   double ambient = 0.45;
@@ -171,6 +205,7 @@ struct LightSpec {
   int shadow_map = 2048;  // px a side of the shadow map, over the camera's view
   double haze_visibility = 0;  // m of meteorological visibility (render/haze.hpp); 0: clear air
   CloudSpec clouds{};
+  SkylightSpec skylight{};
 
   template <class V>
   void visit(V& v) {
@@ -185,6 +220,7 @@ struct LightSpec {
     v("haze_visibility", haze_visibility, geometry::ge(0));
     v.section("clouds", [&](auto& x) { clouds.visit(x); });
     v.check("clouds", clouds.cover == 0 || shadows, "cloud shadows need shadows: true");
+    v.section("skylight", [&](auto& x) { skylight.visit(x); });
   }
   // The way the light travels: the sun's when it is enabled, else `direction`; unit length.
   Eigen::Vector3d travel() const;

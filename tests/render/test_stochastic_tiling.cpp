@@ -1,0 +1,131 @@
+// Stochastic tiling of a ground texture, with both backends: a nadir frame over several copies of
+// the image shows no copy again one period away (where repeat tiling shows the very same pixels),
+// keeps the image's mean and contrast, and never wraps a piece over the image's border (where
+// repeat tiling draws the seam of a photo that is not periodic).
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <random>
+
+#include "geometry/rotation.hpp"
+#include "render/renderer.hpp"
+#include "render_test_support.hpp"
+
+namespace wingman::render {
+namespace {
+
+using testing::backend_name;
+
+constexpr double kTileW = 20, kTileH = 15;  // m one copy of the 256 x 192 image covers
+
+// A flat 200 m square whose texture coordinates repeat every kTileW x kTileH metres.
+Mesh tiled_ground() {
+  Mesh m;
+  m.material = 0;
+  const double h = 100;
+  for (const auto& [x, y] : {std::pair{-h, -h}, {h, -h}, {h, h}, {-h, h}})
+    m.add({x, y, 0}, {0, 0, 1}, {x / kTileW, -y / kTileH}, {1, 1, 1});
+  m.indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+// Smooth random texture (features some 8 texels across), grey levels about 128 +- 40.
+cv::Mat noise_texture() {
+  cv::Mat n(192, 256, CV_32F);
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g(0, 1);
+  for (int r = 0; r < n.rows; ++r)
+    for (int c = 0; c < n.cols; ++c) n.at<float>(r, c) = g(rng);
+  cv::GaussianBlur(n, n, cv::Size(0, 0), 3, 3, cv::BORDER_REFLECT);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(n, mean, sd);
+  cv::Mat u8;
+  n.convertTo(u8, CV_8U, 40 / sd[0], 128 - 40 * mean[0] / sd[0]);
+  cv::Mat rgb;
+  cv::cvtColor(u8, rgb, cv::COLOR_GRAY2RGB);
+  return rgb;
+}
+
+// A ramp from black at the image's left edge to white at its right: a seam wherever it wraps.
+cv::Mat ramp_texture() {
+  cv::Mat g(192, 256, CV_8U);
+  for (int c = 0; c < g.cols; ++c) g.col(c).setTo(c);
+  cv::Mat rgb;
+  cv::cvtColor(g, rgb, cv::COLOR_GRAY2RGB);
+  return rgb;
+}
+
+Scene ground_scene(const cv::Mat& texture, bool stochastic) {
+  Scene s;
+  Material m;
+  m.texture = texture;
+  m.unlit = true;  // the frame shows the texture's own grey levels
+  if (stochastic) m.stochastic_cell = 0.25;
+  s.materials.push_back(m);
+  s.static_meshes.push_back(tiled_ground());
+  s.msaa = 1;
+  return s;
+}
+
+// 10 cm a pixel from 40 m: the 400 x 400 frame spans 2 x 2.7 copies; one period is 200 px across.
+cv::Mat nadir_frame(GlContext& ctx, const cv::Mat& texture, bool stochastic) {
+  const geometry::PinholeCamera cam(400, 400, 199.5, 199.5, 400, 400);
+  Renderer r(ctx, ground_scene(texture, stochastic));
+  cv::Mat g;
+  cv::cvtColor(r.render({cam, {geometry::nadir_R_CW(), {3, -2, 40}}}).rgb, g, cv::COLOR_RGB2GRAY);
+  return g;
+}
+
+double ncc(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat r;
+  cv::matchTemplate(a, b, r, cv::TM_CCOEFF_NORMED);
+  return r.at<float>(0, 0);
+}
+
+class StochasticTilingTest : public ::testing::TestWithParam<GlBackend> {};
+
+TEST_P(StochasticTilingTest, NoCopyOfTheImageRecursOnePeriodAway) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  const cv::Mat tex = noise_texture();
+  const cv::Mat repeat = nadir_frame(ctx, tex, false), stochastic = nadir_frame(ctx, tex, true);
+  double worst = -1;
+  for (const auto& [c, r] : {std::pair{20, 20}, {60, 150}, {100, 300}, {130, 60}}) {
+    const cv::Rect a(c, r, 64, 64), b(c + 200, r, 64, 64);  // one period (20 m) to the east
+    EXPECT_GT(ncc(repeat(a), repeat(b)), 0.97) << c << ", " << r;
+    worst = std::max(worst, ncc(stochastic(a), stochastic(b)));
+  }
+  EXPECT_LT(worst, 0.5);
+}
+
+TEST_P(StochasticTilingTest, TheImagesMeanAndContrastAreKept) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  const cv::Mat tex = noise_texture();
+  cv::Scalar m_rep, sd_rep, m_st, sd_st;
+  cv::meanStdDev(nadir_frame(ctx, tex, false), m_rep, sd_rep);
+  cv::meanStdDev(nadir_frame(ctx, tex, true), m_st, sd_st);
+  // The frame holds some 40 pieces drawn from the image's interior: their mean strays from the
+  // image's by a few grey levels, a tenth of its spread.
+  EXPECT_NEAR(m_st[0], m_rep[0], 0.2 * sd_rep[0]);
+  EXPECT_NEAR(sd_st[0] / sd_rep[0], 1.0, 0.1) << sd_st[0] << " against " << sd_rep[0];
+}
+
+TEST_P(StochasticTilingTest, NoPieceWrapsOverTheImagesBorder) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  const cv::Mat tex = ramp_texture();
+  auto steepest = [](const cv::Mat& g) {  // the largest step between neighbours along a row
+    cv::Mat d;
+    cv::absdiff(g.colRange(1, g.cols), g.colRange(0, g.cols - 1), d);
+    double hi = 0;
+    cv::minMaxLoc(d, nullptr, &hi);
+    return hi;
+  };
+  EXPECT_GT(steepest(nadir_frame(ctx, tex, false)), 150);  // the seam, once a period
+  EXPECT_LT(steepest(nadir_frame(ctx, tex, true)), 80);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, StochasticTilingTest,
+                         ::testing::Values(GlBackend::Egl, GlBackend::OsMesa), backend_name);
+
+}  // namespace
+}  // namespace wingman::render
