@@ -52,14 +52,14 @@ struct TextureSpec {
   // m: the world point of one copy's top-left corner (tiled), so that a flight can lie inside one
   // copy of a large image and see no repetition.
   double origin_x = 0, origin_y = 0;
-  // How a tiled texture fills a world larger than one copy (docs/rendering.md, Ground): stochastic
-  // lays a triangle grid over the ground and shows at each of its vertices a piece of the image
-  // from a place drawn for that vertex, blended across the cells with the image's variance kept
-  // (Heitz & Neyret 2018), so that no copy, lattice or seam of the image repeats; repeat tiles the
-  // image as it is. `cell`: the grid's side as a fraction of the image's shorter side;
-  // `blend_sharpness`: the power of the blend weights (1: linear blend; higher: narrower
-  // transitions, most of the ground one piece of the photo at a time).
-  Tiling tiling = Tiling::Stochastic;
+  // How a tiled texture fills a world larger than one copy (docs/rendering.md, The world): repeat
+  // tiles the image as it is; stochastic lays a triangle grid over the ground and shows at each of
+  // its vertices a piece of the image from a place drawn for that vertex, blended across the cells
+  // with the image's variance kept (Heitz & Neyret 2018), so that no copy, lattice or seam of the
+  // image repeats (but its content recurs at random offsets: docs/studies/ground-tiling.md).
+  // `cell`: the grid's side as a fraction of the image's shorter side; `blend_sharpness`: the
+  // power of the blend weights (1: linear blend; higher: narrower transitions).
+  Tiling tiling = Tiling::Repeat;
   double cell = 0.25;
   double blend_sharpness = 8;
   double detail_min = 0.02;  // m, finest and coarsest detail of the procedural texture
