@@ -383,6 +383,15 @@ std::vector<UavSpec> paper_uavs() {
   return {u1, u2};
 }
 
+// A variant may light the world otherwise (the same flight under another sky: a condition of the
+// frontend benchmark); the world's ground, objects and lead stay the base's.
+void apply_variant_light(const Ctx& ctx, const MapView& m, Scenario& v) {
+  const auto f = m.get("world");
+  if (!f) return;
+  const MapView w(ctx, *f, {"light"}, [](const std::string&) { return std::string(" (a variant may set only world.light)"); });
+  if (auto light = w.get("light")) read_settings(ctx, *light, v.world.light);
+}
+
 std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   const std::vector<std::string_view> top_keys = {
       "name",  "duration",  "rate",   "seed",    "measurements", "lead",    "uavs",
@@ -441,7 +450,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
     ctx.fail(vf->loc(), fmt::format("expected a list of variants, got {}", describe(vf->node)));
   if (vf->node.size() == 0) ctx.fail(vf->loc(), "expected at least one variant");
 
-  std::vector<std::string_view> variant_keys = {"name"};
+  std::vector<std::string_view> variant_keys = {"name", "world"};
   variant_keys.insert(variant_keys.end(), kCommonKeys.begin(), kCommonKeys.end());
   const auto note = [&](const std::string& key) -> std::string {
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end()) return "";
@@ -465,6 +474,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
     Provenance vp = prov;
     v.variant = name;
     apply_common(ctx, m, v, vp);
+    apply_variant_light(ctx, m, v);
     finalise(ctx, v, vp);
     out.push_back(std::move(v));
     name_locs.push_back(nf.loc());
