@@ -450,8 +450,9 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
     ctx.fail(vf->loc(), fmt::format("expected a list of variants, got {}", describe(vf->node)));
   if (vf->node.size() == 0) ctx.fail(vf->loc(), "expected at least one variant");
 
-  std::vector<std::string_view> variant_keys = {"name", "world"};
+  std::vector<std::string_view> variant_keys = {"name"};
   variant_keys.insert(variant_keys.end(), kCommonKeys.begin(), kCommonKeys.end());
+  variant_keys.push_back("world");  // its light only: apply_variant_light
   const auto note = [&](const std::string& key) -> std::string {
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end()) return "";
     return fmt::format(" (a variant may set only {})", join(variant_keys));

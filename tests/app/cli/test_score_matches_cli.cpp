@@ -53,7 +53,7 @@ class ScoreMatchesCli : public ::testing::Test {
   static inline std::string skip_reason_, render_error_;
 };
 
-const char* kPairsHeader = "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m\n";
+const char* kPairsHeader = "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m\n";  // the reference-only columns
 
 // Two pairs: uav1 at 0 s and 0.5 s (temporal), uav1 and uav2 at 0 s (cross).
 std::string two_pairs() {
@@ -126,12 +126,14 @@ TEST_F(ScoreMatchesCli, PairsListsTemporalAndCrossPairsWithBaselines) {
   // 11 frames, stride 10, gaps 1, 5, 10: per UAV three temporal pairs from frame 0; cross pairs at
   // frames 0 and 10.
   ASSERT_EQ(lines.size(), 9u) << r.output;
-  EXPECT_EQ(lines[0] + "\n", kPairsHeader);
+  EXPECT_EQ(lines[0], "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m,condition");
   EXPECT_THAT(lines[1], ::testing::StartsWith("0,uav1,0,uav1,100000000,temporal,"));
   EXPECT_THAT(lines[7], ::testing::StartsWith("6,uav1,0,uav2,0,cross,"));
   EXPECT_THAT(lines[8], ::testing::StartsWith("7,uav1,1000000000,uav2,1000000000,cross,"));
   // The UAVs fly 3 m apart horizontally and 2 m vertically at the start.
-  const double baseline = std::stod(lines[7].substr(lines[7].rfind(',') + 1));
+  EXPECT_THAT(lines[7], ::testing::EndsWith(",reference"));
+  const std::string before_condition = lines[7].substr(0, lines[7].rfind(','));
+  const double baseline = std::stod(before_condition.substr(before_condition.rfind(',') + 1));
   EXPECT_NEAR(baseline, std::sqrt(3.0 * 3.0 + 2.0 * 2.0), 0.3);
 }
 
