@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/app_test_support.hpp"
-#include "gl_required.hpp"
+#include "app/cli/rendered_suite.hpp"
 
 namespace wingman::app::test {
 namespace {
@@ -35,36 +35,20 @@ std::string scenario() {
          uavs(", shutter: {type: rolling, line_delay: 4.0e-4, rows_per_band: 4}", "      ");
 }
 
-class ConditionsCli : public ::testing::Test {
+class ConditionsCli : public RenderedSuite<ConditionsCli> {
+ public:
+  static std::string render(const fs::path& dir) {
+    write_file(dir / "cond.yaml", scenario());
+    const RunResult r = run_wingman({"render", (dir / "cond.yaml").string(), "--variant", "ideal", "--variant",
+                                     "rolling", "--quiet", "--out", (dir / "ds").string()},
+                                    dir);
+    return r.exit_code == 0 ? "" : r.output;
+  }
+
  protected:
-  static void SetUpTestSuite() {
-    std::string why;
-    if (!wingman::testing::gl_available(&why)) {
-      skip_reason_ = why;
-      return;
-    }
-    dir_ = new TempDir();
-    write_file(dir_->path() / "cond.yaml", scenario());
-    const RunResult r = run_wingman({"render", (dir_->path() / "cond.yaml").string(), "--variant", "ideal", "--variant",
-                                     "rolling", "--quiet", "--out", (dir_->path() / "ds").string()},
-                                    dir_->path());
-    if (r.exit_code != 0) render_error_ = r.output;
-  }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  void SetUp() override {
-    if (!skip_reason_.empty()) WINGMAN_NO_GL_CONTEXT(skip_reason_);
-    ASSERT_TRUE(render_error_.empty()) << render_error_;
-  }
-  static fs::path tmp() { return dir_->path(); }
   static std::string ideal() { return (tmp() / "ds" / "ideal").string(); }
   static std::string rolling() { return "rolling=" + (tmp() / "ds" / "rolling").string(); }
   static std::string same() { return "same=" + ideal(); }  // the reference's own frames: identical imaging
-
-  static inline TempDir* dir_ = nullptr;
-  static inline std::string skip_reason_, render_error_;
 };
 
 // scores.csv's rows as maps from column name to value.

@@ -13,44 +13,28 @@
 #include <nlohmann/json.hpp>
 
 #include "app/app_test_support.hpp"
+#include "app/cli/rendered_suite.hpp"
 #include "datasets/dataset.hpp"
 #include "frontend_bench/correspondence.hpp"
 #include "frontend_bench/match_files.hpp"
-#include "gl_required.hpp"
 
 namespace wingman::app::test {
 namespace {
 
 using ::testing::HasSubstr;
 
-class ScoreMatchesCli : public ::testing::Test {
- protected:
+class ScoreMatchesCli : public RenderedSuite<ScoreMatchesCli> {
+ public:
   // One dataset for the suite: rendering is the slow part.
-  static void SetUpTestSuite() {
-    std::string why;
-    if (!wingman::testing::gl_available(&why)) {
-      skip_reason_ = why;
-      return;
-    }
-    dir_ = new TempDir();
-    const RunResult r = run_wingman({"render", "scenes/rendered_smoke.yaml", "--variant", "multi",
-                                     "--frames", "11", "--quiet", "--out", ds().string()},
-                                    dir_->path());
-    if (r.exit_code != 0) render_error_ = r.output;
+  static std::string render(const fs::path& dir) {
+    const RunResult r = run_wingman({"render", "scenes/rendered_smoke.yaml", "--variant", "multi", "--frames", "11",
+                                     "--quiet", "--out", (dir / "ds").string()},
+                                    dir);
+    return r.exit_code == 0 ? "" : r.output;
   }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  void SetUp() override {
-    if (!skip_reason_.empty()) WINGMAN_NO_GL_CONTEXT(skip_reason_);
-    ASSERT_TRUE(render_error_.empty()) << render_error_;
-  }
-  static fs::path ds() { return dir_->path() / "ds"; }
-  static fs::path tmp() { return dir_->path(); }
 
-  static inline TempDir* dir_ = nullptr;
-  static inline std::string skip_reason_, render_error_;
+ protected:
+  static fs::path ds() { return tmp() / "ds"; }
 };
 
 const char* kPairsHeader = "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m\n";  // the reference-only columns
