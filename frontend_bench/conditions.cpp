@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <stdexcept>
 
@@ -58,8 +59,10 @@ void check_agent(const datasets::Dataset& ref, const datasets::AgentData& r, con
   }
 }
 
+constexpr std::size_t kMaxNameLength = 64;  // a condition names a folder of keypoints
+
 bool name_ok(const std::string& s) {
-  return !s.empty() && s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char ch) {
+  return !s.empty() && s.size() <= kMaxNameLength && std::all_of(s.begin(), s.end(), [](char ch) {
     return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
   });
 }
@@ -83,7 +86,8 @@ Conditions::Conditions(const datasets::Dataset& reference, std::vector<Condition
     const std::string& n = conditions_[i].name;
     if (!name_ok(n) || n == kReference)
       throw std::invalid_argument(fmt::format(
-          "condition name '{}' must match [A-Za-z0-9_-]+ (at most 64 characters) and not be '{}'", n, kReference));
+          "condition name '{}' must match [A-Za-z0-9_-]+ (at most {} characters) and not be '{}'", n, kMaxNameLength,
+          kReference));
     for (std::size_t j = 0; j < i; ++j)
       if (conditions_[j].name == n) throw std::invalid_argument(fmt::format("condition '{}' given twice", n));
     check_condition(reference, conditions_[i]);

@@ -478,6 +478,8 @@ fs::path plot_conditions(const std::vector<std::string>& methods, const std::vec
                      "cross-UAV pairs)", threshold_px)),
       tics, static_cast<double>(conditions.size()) - 0.5);
   for (const char* column : {"precision", "recall", "repeatability"}) {
+    // One key, on the precision panel, whose lines lie highest: the key would hide the others' lines.
+    if (column[0] == 'r') s += "unset key\n";
     s += fmt::format("set title {}\nset ylabel {}\nplot ", gq(column), gq(column));
     for (std::size_t m = 0; m < methods.size(); ++m)
       for (const auto& [type, dash] : {std::pair{"same-instant", 1}, std::pair{"temporal", 2}, std::pair{"cross", 3}})
