@@ -215,6 +215,27 @@ int read_channels(const YAML::Node& n, const fs::path& file, int version) {
   fail(file, fmt::format("encoding '{}': expected mono8 or rgb8 (mono16 for depth)", enc));
 }
 
+// cam0's shutter (docs/datasets.md, shutter and exposure); a dataset without one was taken through
+// a global shutter with no exposure time.
+void read_shutter(const YAML::Node& n, const fs::path& file, CameraInfo& c) {
+  const YAML::Node s = n["shutter"];
+  if (!s) return;
+  if (!s.IsMap()) fail(file, "shutter must be a map");
+  const auto type = get<std::string>(s, file, "type");
+  const auto readout = get<std::string>(s, file, "readout");
+  if (type != "global" && type != "rolling") fail(file, fmt::format("shutter.type '{}': expected global or rolling", type));
+  if (readout != "top_to_bottom" && readout != "bottom_to_top")
+    fail(file, fmt::format("shutter.readout '{}': expected top_to_bottom or bottom_to_top", readout));
+  c.exposure_s = get<double>(s, file, "exposure_s");
+  c.line_delay_s = get<double>(s, file, "line_delay_s");
+  if (!(c.exposure_s >= 0 && c.exposure_s <= 1)) fail(file, fmt::format("shutter.exposure_s {} must be in [0, 1]", c.exposure_s));
+  if (!(c.line_delay_s >= 0 && c.line_delay_s <= 1e-3))
+    fail(file, fmt::format("shutter.line_delay_s {} must be in [0, 0.001]", c.line_delay_s));
+  c.rolling = type == "rolling";
+  if (c.rolling && c.line_delay_s == 0) fail(file, "shutter.line_delay_s must be above 0 for a rolling shutter");
+  c.top_to_bottom = readout == "top_to_bottom";
+}
+
 CameraInfo read_camera(const fs::path& file, double rate_fallback, int version) {
   const YAML::Node n = load_yaml(file);
   const auto res = numbers(n, file, "resolution", 2);
@@ -235,6 +256,7 @@ CameraInfo read_camera(const fs::path& file, double rate_fallback, int version) 
   c.rate = n["rate_hz"] ? get<double>(n, file, "rate_hz") : rate_fallback;
   if (!(c.rate > 0 && c.rate <= 1000)) fail(file, fmt::format("rate_hz must be in (0, 1000], got {}", c.rate));
   c.channels = read_channels(n, file, version);
+  read_shutter(n, file, c);
   return c;
 }
 

@@ -5,6 +5,7 @@
 #include <ctime>
 #include <map>
 #include <set>
+#include <tuple>
 
 namespace wingman::frontend_bench {
 
@@ -15,11 +16,11 @@ namespace {
 // Features of the frames a few consecutive pairs share, detected once each.
 class FeatureCache {
  public:
-  FeatureCache(const datasets::Dataset& ds, const vision::FeatureExtractor& fx, const fs::path& dir,
+  FeatureCache(const Conditions& sets, const vision::FeatureExtractor& fx, const fs::path& dir,
                BuiltinFrontendRun& run)
-      : ds_(ds), fx_(fx), dir_(dir), run_(run) {}
-  const vision::Features& get(const std::string& agent, std::int64_t t_ns) {
-    const auto key = std::make_pair(agent, t_ns);
+      : sets_(sets), fx_(fx), dir_(dir), run_(run) {}
+  const vision::Features& get(const std::string& condition, const std::string& agent, std::int64_t t_ns) {
+    const Key key{condition, agent, t_ns};
     if (const auto it = cache_.find(key); it != cache_.end()) {
       order_.erase(std::find(order_.begin(), order_.end(), key));
       order_.push_back(key);
@@ -29,7 +30,7 @@ class FeatureCache {
       cache_.erase(order_.front());
       order_.erase(order_.begin());
     }
-    const cv::Mat image = ds_.load_image(agent, t_ns);
+    const cv::Mat image = sets_.find(condition)->load_image(agent, t_ns);
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
     vision::Features f = fx_.detect(image);
@@ -40,7 +41,7 @@ class FeatureCache {
     if (!written_.count(key)) {  // a frame evicted and seen again is detected again, written once
       std::vector<Keypoint> kps;
       for (const auto& k : f.keypoints) kps.push_back({{k.pt.x, k.pt.y}, k.response});
-      write_keypoints(keypoints_file(dir_, agent, t_ns), kps);
+      write_keypoints(keypoints_file(dir_, condition, agent, t_ns), kps);
       written_.insert(key);
     }
     order_.push_back(key);
@@ -49,8 +50,8 @@ class FeatureCache {
 
  private:
   static constexpr std::size_t kMaxFrames = 48;
-  using Key = std::pair<std::string, std::int64_t>;
-  const datasets::Dataset& ds_;
+  using Key = std::tuple<std::string, std::string, std::int64_t>;  // condition, agent, t_ns
+  const Conditions& sets_;
   const vision::FeatureExtractor& fx_;
   fs::path dir_;
   BuiltinFrontendRun& run_;
@@ -61,17 +62,17 @@ class FeatureCache {
 
 }  // namespace
 
-BuiltinFrontendRun run_builtin_frontend(const datasets::Dataset& ds,
+BuiltinFrontendRun run_builtin_frontend(const Conditions& sets,
                                         const std::vector<FramePair>& pairs,
                                         const BuiltinFrontendOptions& options, const fs::path& dir,
                                         const std::function<void(int, int)>& progress) {
   const vision::FeatureExtractor fx(options.features);
   BuiltinFrontendRun run;
-  FeatureCache cache(ds, fx, dir, run);
+  FeatureCache cache(sets, fx, dir, run);
   int done = 0;
   for (const auto& p : pairs) {
-    const vision::Features& a = cache.get(p.agent_a, p.t_a);
-    const vision::Features& b = cache.get(p.agent_b, p.t_b);
+    const vision::Features& a = cache.get(kReference, p.agent_a, p.t_a);
+    const vision::Features& b = cache.get(p.condition, p.agent_b, p.t_b);
     std::vector<Match> matches;
     for (const auto& m : vision::match_descriptors(a, b, options.matching)) matches.push_back({m.queryIdx, m.trainIdx});
     write_matches(matches_file(dir, p.id), matches);

@@ -15,7 +15,7 @@ namespace wingman::frontend_bench {
 
 // One built-in detector outside the SLAM loop: each frame of the pairs detected and described
 // once (timed), each pair matched by descriptor, keypoints and matches written under dir in the
-// benchmark's file format.
+// benchmark's file format (a condition's frames under dir/conditions/<condition>/).
 struct BuiltinFrontendOptions {
   vision::FeatureSettings features;
   vision::DescriptorMatchSettings matching;
@@ -26,7 +26,7 @@ struct BuiltinFrontendRun {
   double detect_cpu_ms = 0;  // the same in CPU time of the process (all of OpenCV's threads)
   long keypoints = 0;
 };
-BuiltinFrontendRun run_builtin_frontend(const datasets::Dataset& ds,
+BuiltinFrontendRun run_builtin_frontend(const Conditions& sets,
                                         const std::vector<FramePair>& pairs,
                                         const BuiltinFrontendOptions& options,
                                         const std::filesystem::path& dir,

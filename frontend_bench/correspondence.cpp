@@ -41,8 +41,9 @@ Correspondence true_correspondence(const FrameTruth& a, const FrameTruth& b,
   const double z_a = depth_at(a.depth, uv_a);
   if (z_a <= 0) return c;  // NoDepth
   const Eigen::Vector2d xn = a.camera.unproject_normalised(uv_a);
-  c.point_W = a.R_CW.transpose() * Eigen::Vector3d(xn.x() * z_a, xn.y() * z_a, z_a) + a.centre;
-  const Eigen::Vector3d p_B = b.R_CW * (c.point_W - b.centre);
+  const geometry::CameraPose pose_a = a.pose.at_row(uv_a.y());
+  c.point_W = pose_a.R_CW.transpose() * Eigen::Vector3d(xn.x() * z_a, xn.y() * z_a, z_a) + pose_a.position;
+  const Eigen::Vector3d p_B = b.pose.to_camera(b.camera, c.point_W);
   c.depth_b = p_B.z();
   const auto uv = b.camera.project(p_B);
   if (!uv) {

@@ -2,22 +2,25 @@
 // a pixel of frame A is undistorted, back-projected to the rendered depth (metres along A's
 // optical axis) with A's true pose, and projected with lens distortion into frame B at its true
 // pose. It has a correspondence only when the point lies in B's image and B's own depth there
-// agrees with the point's depth in B (otherwise something nearer hides it).
+// agrees with the point's depth in B (otherwise something nearer hides it). Under a rolling
+// shutter the pose is the row's: A's pixel is back-projected with its row's pose, and the point
+// lands in B on the row whose own pose projects it onto that row, where B's depth (each row drawn
+// from its own pose) is compared with its depth in that row's camera.
 #pragma once
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "geometry/camera.hpp"
+#include "geometry/frame_poses.hpp"
 
 namespace wingman::frontend_bench {
 
-// One frame's truth: its camera, the true world-to-camera rotation and camera centre, and the
-// rendered depth (CV_32F metres along the optical axis, 0 = no surface).
+// One frame's truth: its camera, its true poses (one, or one per row under a rolling shutter) and
+// the rendered depth (CV_32F metres along the optical axis, 0 = no surface).
 struct FrameTruth {
   geometry::PinholeCamera camera;
-  Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  geometry::FramePoses pose;
   cv::Mat depth;
 };
 

@@ -1,6 +1,7 @@
 // The matching benchmark's outputs: the table on stdout, and in a results directory
 // scores.json (every group's counts and ratios at every threshold), scores.csv (one row per
-// method and group), curves.csv and plots/match_curves.png (docs/frontend.md).
+// method and group), curves.csv and plots/match_curves.png, and with conditions conditions.csv
+// and plots/conditions.png (docs/frontend.md).
 #pragma once
 
 #include <filesystem>
@@ -32,9 +33,14 @@ struct MatcherOptions {
   int max_features = 0;
 };
 
+struct ConditionInfo {
+  std::string name, dataset;
+};
+
 struct MatchReport {
   std::string dataset;
-  std::size_t pairs = 0, temporal_pairs = 0, cross_pairs = 0;
+  std::vector<ConditionInfo> conditions;  // besides the reference
+  std::size_t pairs = 0, temporal_pairs = 0, cross_pairs = 0, same_instant_pairs = 0;
   ScoreOptions options;
   // The pairs' limit to the dataset's first seconds or frames (--duration / --frames), if any.
   std::optional<double> duration_s;
@@ -43,15 +49,20 @@ struct MatchReport {
   std::vector<MethodScores> methods;
 };
 
-MatchReport make_report(const std::string& dataset, const std::vector<FramePair>& pairs,
+MatchReport make_report(const std::string& dataset, const Conditions& sets, const std::vector<FramePair>& pairs,
                         const ScoreOptions& options);
 
-// One row per method and group; precision and recall at 1, 3 and 5 px where those thresholds
-// are scored (else the first three), repeatability and localisation at localisation_px.
+// "99 pairs (84 temporal, 15 cross-UAV)", with the same-instant pairs and conditions when there are.
+std::string describe_pairs(const MatchReport& report);
+
+// One row per method and group (with a condition column when there are conditions); precision
+// and recall at 1, 3 and 5 px where those thresholds are scored (else the first three),
+// repeatability and localisation at localisation_px.
 std::string format_match_table(const MatchReport& report);
 
-// scores.json, scores.csv and curves.csv into dir (which must exist), and the plot unless
-// `plots` is false. Throws std::runtime_error naming a file that cannot be written.
+// scores.json, scores.csv, curves.csv and, with conditions, conditions.csv into dir (which must
+// exist), and the plots unless `plots` is false. Throws std::runtime_error naming a file that
+// cannot be written.
 void write_match_report(const MatchReport& report, const std::filesystem::path& dir, bool plots);
 
 }  // namespace wingman::frontend_bench

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <stdexcept>
+#include <tuple>
 #include <unordered_map>
 
 namespace wingman::frontend_bench {
@@ -56,6 +57,30 @@ std::string bin_name(const std::vector<double>& edges, std::size_t i) {
 
 std::size_t bin_of(const std::vector<double>& edges, double baseline) {
   return static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), baseline) - edges.begin());
+}
+
+// One condition's groups: all its pairs, then per type all baselines and each bin holding pairs.
+void append_condition_groups(const std::string& condition, const std::vector<FramePair>& pairs,
+                             const std::vector<MatchCounts>& counts, const ScoreOptions& o,
+                             std::vector<GroupScore>& groups) {
+  const std::size_t nt = o.thresholds_px.size(), nb = o.baseline_edges_m.size() + 1;
+  const std::size_t first = groups.size();
+  groups.push_back({condition, "all", "all", MatchCounts(nt)});
+  for (const PairType type : kPairTypes) {
+    GroupScore all{condition, to_string(type), "all", MatchCounts(nt)};
+    std::vector<MatchCounts> bins(nb, MatchCounts(nt));
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      if (pairs[i].type != type || pairs[i].condition != condition) continue;
+      all.counts.add(counts[i]);
+      bins[bin_of(o.baseline_edges_m, pairs[i].baseline_m)].add(counts[i]);
+    }
+    if (all.counts.pairs == 0) continue;
+    groups[first].counts.add(all.counts);
+    groups.push_back(all);
+    for (std::size_t k = 0; k < nb; ++k)
+      if (bins[k].pairs > 0) groups.push_back({condition, to_string(type), bin_name(o.baseline_edges_m, k), bins[k]});
+  }
+  if (groups[first].counts.pairs == 0) groups.erase(groups.begin() + static_cast<long>(first));
 }
 
 }  // namespace
@@ -141,13 +166,13 @@ namespace {
 // frame); the least recently used are dropped beyond a few dozen.
 class FrameCache {
  public:
-  FrameCache(const datasets::Dataset& ds, const fs::path& dir) : ds_(ds), dir_(dir) {}
+  FrameCache(const Conditions& sets, const fs::path& dir) : sets_(sets), dir_(dir) {}
   struct Frame {
     FrameTruth truth;
     std::vector<Keypoint> keypoints;
   };
-  const Frame& get(const std::string& agent, std::int64_t t_ns) {
-    const auto key = std::make_pair(agent, t_ns);
+  const Frame& get(const std::string& condition, const std::string& agent, std::int64_t t_ns) {
+    const Key key{condition, agent, t_ns};
     if (const auto it = frames_.find(key); it != frames_.end()) {  // least recently used goes first
       order_.erase(std::find(order_.begin(), order_.end(), key));
       order_.push_back(key);
@@ -158,8 +183,8 @@ class FrameCache {
       order_.erase(order_.begin());
     }
     Frame f;
-    f.truth = frame_truth(ds_, agent, t_ns);
-    f.keypoints = read_keypoints(keypoints_file(dir_, agent, t_ns), f.truth.camera.width(),
+    f.truth = frame_truth(*sets_.find(condition), agent, t_ns);
+    f.keypoints = read_keypoints(keypoints_file(dir_, condition, agent, t_ns), f.truth.camera.width(),
                                  f.truth.camera.height());
     order_.push_back(key);
     return frames_.emplace(key, std::move(f)).first->second;
@@ -167,25 +192,26 @@ class FrameCache {
 
  private:
   static constexpr std::size_t kMaxFrames = 48;
-  const datasets::Dataset& ds_;
+  using Key = std::tuple<std::string, std::string, std::int64_t>;
+  const Conditions& sets_;
   fs::path dir_;
-  std::map<std::pair<std::string, std::int64_t>, Frame> frames_;
-  std::vector<std::pair<std::string, std::int64_t>> order_;
+  std::map<Key, Frame> frames_;
+  std::vector<Key> order_;
 };
 
 }  // namespace
 
-std::vector<MatchCounts> score_directory(const datasets::Dataset& ds, const std::vector<FramePair>& pairs,
+std::vector<MatchCounts> score_directory(const Conditions& sets, const std::vector<FramePair>& pairs,
                                          const fs::path& dir, const ScoreOptions& options,
                                          const std::function<void(int, int)>& progress) {
   options.validate();
   if (!fs::is_directory(dir)) throw MatchInputError(dir.string() + ": not a directory");
-  FrameCache cache(ds, dir);
+  FrameCache cache(sets, dir);
   std::vector<MatchCounts> out;
   out.reserve(pairs.size());
   for (const FramePair& p : pairs) {
-    const auto& a = cache.get(p.agent_a, p.t_a);
-    const auto& b = cache.get(p.agent_b, p.t_b);
+    const auto& a = cache.get(kReference, p.agent_a, p.t_a);
+    const auto& b = cache.get(p.condition, p.agent_b, p.t_b);
     const auto matches = read_matches(matches_file(dir, p.id), static_cast<int>(a.keypoints.size()),
                                       static_cast<int>(b.keypoints.size()));
     out.push_back(score_pair(a.truth, b.truth, a.keypoints, b.keypoints, matches, options));
@@ -197,22 +223,11 @@ std::vector<MatchCounts> score_directory(const datasets::Dataset& ds, const std:
 std::vector<GroupScore> group_scores(const std::vector<FramePair>& pairs,
                                      const std::vector<MatchCounts>& counts, const ScoreOptions& o) {
   if (pairs.size() != counts.size()) throw std::invalid_argument("group_scores: one count per pair");
-  const std::size_t nt = o.thresholds_px.size(), nb = o.baseline_edges_m.size() + 1;
-  std::vector<GroupScore> groups{{"all", "all", MatchCounts(nt)}};
-  for (const PairType type : {PairType::Temporal, PairType::Cross}) {
-    GroupScore all{to_string(type), "all", MatchCounts(nt)};
-    std::vector<MatchCounts> bins(nb, MatchCounts(nt));
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-      if (pairs[i].type != type) continue;
-      all.counts.add(counts[i]);
-      bins[bin_of(o.baseline_edges_m, pairs[i].baseline_m)].add(counts[i]);
-    }
-    if (all.counts.pairs == 0) continue;
-    groups[0].counts.add(all.counts);
-    groups.push_back(all);
-    for (std::size_t k = 0; k < nb; ++k)
-      if (bins[k].pairs > 0) groups.push_back({to_string(type), bin_name(o.baseline_edges_m, k), bins[k]});
-  }
+  std::vector<std::string> conditions{kReference};
+  for (const auto& p : pairs)
+    if (std::find(conditions.begin(), conditions.end(), p.condition) == conditions.end()) conditions.push_back(p.condition);
+  std::vector<GroupScore> groups;
+  for (const auto& c : conditions) append_condition_groups(c, pairs, counts, o, groups);
   return groups;
 }
 

@@ -51,18 +51,21 @@ MatchCounts score_pair(const FrameTruth& a, const FrameTruth& b, const std::vect
                        const std::vector<Keypoint>& kp_b, const std::vector<Match>& matches,
                        const ScoreOptions& options);
 
-// The counts of every pair of a submission directory (keypoints/, matches/), each file checked
-// as it is read (MatchInputError naming file and line). `progress(done, total)` after each pair.
-std::vector<MatchCounts> score_directory(const datasets::Dataset& ds,
+// The counts of every pair of a submission directory (keypoints/, conditions/, matches/), each
+// file checked as it is read (MatchInputError naming file and line); frame B of a pair comes from
+// its condition's dataset. `progress(done, total)` after each pair.
+std::vector<MatchCounts> score_directory(const Conditions& sets,
                                          const std::vector<FramePair>& pairs,
                                          const std::filesystem::path& dir,
                                          const ScoreOptions& options,
                                          const std::function<void(int, int)>& progress = {});
 
-// Pooled counts per group: all pairs, then per pair type all baselines and each baseline bin
-// holding pairs. `type` is "all", "temporal" or "cross"; `baseline` "all" or a bin, "lo-hi m" ([lo, hi)) or ">=lo m".
+// Pooled counts per group: per condition (the reference first, then the others in the order of
+// their first pair) all its pairs, then per pair type all baselines and each baseline bin holding
+// pairs. `type` is "all", "temporal", "cross" or "same-instant"; `baseline` "all" or a bin,
+// "lo-hi m" ([lo, hi)) or ">=lo m".
 struct GroupScore {
-  std::string type, baseline;
+  std::string condition, type, baseline;
   MatchCounts counts;
 };
 std::vector<GroupScore> group_scores(const std::vector<FramePair>& pairs,

@@ -383,6 +383,15 @@ std::vector<UavSpec> paper_uavs() {
   return {u1, u2};
 }
 
+// A variant may light the world otherwise (the same flight under another sky: a condition of the
+// frontend benchmark); the world's ground, objects and lead stay the base's.
+void apply_variant_light(const Ctx& ctx, const MapView& m, Scenario& v) {
+  const auto f = m.get("world");
+  if (!f) return;
+  const MapView w(ctx, *f, {"light"}, [](const std::string&) { return std::string(" (a variant may set only world.light)"); });
+  if (auto light = w.get("light")) read_settings(ctx, *light, v.world.light);
+}
+
 std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
   const std::vector<std::string_view> top_keys = {
       "name",  "duration",  "rate",   "seed",    "measurements", "lead",    "uavs",
@@ -443,6 +452,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
 
   std::vector<std::string_view> variant_keys = {"name"};
   variant_keys.insert(variant_keys.end(), kCommonKeys.begin(), kCommonKeys.end());
+  variant_keys.push_back("world");  // its light only: apply_variant_light
   const auto note = [&](const std::string& key) -> std::string {
     if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end()) return "";
     return fmt::format(" (a variant may set only {})", join(variant_keys));
@@ -465,6 +475,7 @@ std::vector<Scenario> parse_document(const Ctx& ctx, const YAML::Node& root) {
     Provenance vp = prov;
     v.variant = name;
     apply_common(ctx, m, v, vp);
+    apply_variant_light(ctx, m, v);
     finalise(ctx, v, vp);
     out.push_back(std::move(v));
     name_locs.push_back(nf.loc());

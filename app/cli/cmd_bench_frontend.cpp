@@ -83,6 +83,7 @@ std::vector<vision::FeatureSettings> detector_settings(const BenchOptions& o, co
 // The whole replay once per detector.
 int in_loop_command(const BenchOptions& o, const std::string& variant) {
   if (!o.output.out.empty()) throw io::UsageError("--out writes the matching benchmark; it does not go with --in-loop");
+  if (!o.pairs.conditions.empty()) throw io::UsageError("--condition goes with the matching benchmark, not with --in-loop");
   Replay replay = load_replay(o.dataset, variant, o.output.quiet);
   apply_step_limit(o.pairs.limit, replay.scenario);
   const RunConfig& scn = replay.scenario;
@@ -167,12 +168,12 @@ int benchmark_command(const BenchOptions& o, const std::string& variant) {
   std::optional<io::ResultsDir> staged;
   open_match_output(o.output, staged);
   const Replay replay = load_replay(o.dataset, variant, o.output.quiet);
-  const datasets::Dataset& ds = replay.dataset;
-  const auto pairs = load_pairs(ds, o.pairs, o.output.quiet);
+  const frontend_bench::Conditions sets = load_conditions(replay.dataset, o.pairs);
+  const auto pairs = load_pairs(sets, o.pairs, o.output.quiet);
   std::optional<ScratchDir> scratch;
   if (!staged) scratch.emplace();
   const fs::path root = staged ? staged->staging() / "frontends" : scratch->path();
-  frontend_bench::MatchReport report = frontend_bench::make_report(o.dataset, pairs, o.score);
+  frontend_bench::MatchReport report = frontend_bench::make_report(o.dataset, sets, pairs, o.score);
   report.duration_s = o.pairs.limit.duration;
   report.frames = o.pairs.limit.frames;
   const std::vector<vision::FeatureSettings> detectors = detector_settings(o, replay.scenario);
@@ -180,12 +181,12 @@ int benchmark_command(const BenchOptions& o, const std::string& variant) {
   for (const auto& f : detectors) {
     const std::string name = vision::to_string(f.kind);
     io::ProgressLine progress(fmt::format("[bench-frontend {}]", name), o.output.quiet);
-    const frontend_bench::BuiltinFrontendRun run = frontend_bench::run_builtin_frontend(ds, pairs, {f, o.matching}, root / name, [&](int k, int n) {
+    const frontend_bench::BuiltinFrontendRun run = frontend_bench::run_builtin_frontend(sets, pairs, {f, o.matching}, root / name, [&](int k, int n) {
       io::throw_if_interrupted();
       progress.update(k, n, "pairs matched");
     });
     // Scored from the files just written, through the reader any other frontend goes through.
-    const auto counts = frontend_bench::score_directory(ds, pairs, root / name, o.score, [&](int k, int n) {
+    const auto counts = frontend_bench::score_directory(sets, pairs, root / name, o.score, [&](int k, int n) {
       io::throw_if_interrupted();
       progress.update(k, n, "pairs scored");
     });
@@ -198,10 +199,8 @@ int benchmark_command(const BenchOptions& o, const std::string& variant) {
     m.groups = frontend_bench::group_scores(pairs, counts, o.score);
     report.methods.push_back(std::move(m));
   }
-  fmt::print("Feature frontends on {}: {} pairs ({} temporal, {} cross-UAV), matched by brute force "
-             "(ratio {}, {})\n",
-             o.dataset, report.pairs, report.temporal_pairs, report.cross_pairs, o.matching.ratio,
-             o.matching.mutual ? "mutual" : "one way");
+  fmt::print("Feature frontends on {}: {}, matched by brute force (ratio {}, {})\n", o.dataset,
+             frontend_bench::describe_pairs(report), o.matching.ratio, o.matching.mutual ? "mutual" : "one way");
   publish_match_report(report, o.output, staged);
   return 0;
 }

@@ -31,7 +31,8 @@ int pairs_command(const PairsOptions& o) {
   if (!o.out.empty() && fs::exists(o.out) && !o.force)
     throw io::UsageError(fmt::format("{}: already exists; pass --force to replace it", o.out));
   const datasets::Dataset ds = datasets::read_dataset(o.dataset);
-  const std::string csv = frontend_bench::pairs_csv(load_pairs(ds, o.pairs, false));
+  const frontend_bench::Conditions sets = load_conditions(ds, o.pairs);
+  const std::string csv = frontend_bench::pairs_csv(load_pairs(sets, o.pairs, false));
   if (o.out.empty()) {
     fmt::print("{}", csv);
   } else {
@@ -57,15 +58,16 @@ int score_matches_command(const ScoreMatchesOptions& o) {
   std::optional<io::ResultsDir> staged;
   open_match_output(o.output, staged);
   const datasets::Dataset ds = datasets::read_dataset(o.dataset);
-  const auto pairs = load_pairs(ds, o.pairs, o.output.quiet);
+  const frontend_bench::Conditions sets = load_conditions(ds, o.pairs);
+  const auto pairs = load_pairs(sets, o.pairs, o.output.quiet);
   io::ProgressLine progress("[score-matches]", o.output.quiet);
-  const auto counts = frontend_bench::score_directory(ds, pairs, o.dir, o.score,
+  const auto counts = frontend_bench::score_directory(sets, pairs, o.dir, o.score,
                                             [&](int k, int n) {
                                               io::throw_if_interrupted();
                                               progress.update(k, n, "pairs");
                                             });
   progress.finish();
-  frontend_bench::MatchReport report = frontend_bench::make_report(o.dataset, pairs, o.score);
+  frontend_bench::MatchReport report = frontend_bench::make_report(o.dataset, sets, pairs, o.score);
   report.duration_s = o.pairs.limit.duration;
   report.frames = o.pairs.limit.frames;
   frontend_bench::MethodScores m;
@@ -87,7 +89,8 @@ Subcommand add_pairs(CLI::App& parent) {
   auto o = std::make_shared<PairsOptions>();
   auto* cmd = parent.add_subcommand(
       "pairs", "List the matching benchmark's frame pairs of a dataset (pair_id, agents, time "
-               "stamps, temporal|cross, baseline): the pairs a frontend writes matches for");
+               "stamps, temporal|cross|same-instant, baseline, condition): the pairs a frontend writes "
+               "matches for");
   cmd->add_option("dataset", o->dataset, "Dataset directory (from wingman render)")->required();
   cmd->add_option("--out,-o", o->out, "Pairs file to write (default: stdout)");
   add_pair_options(cmd, o->pairs, false);
@@ -102,7 +105,9 @@ Subcommand add_score_matches(CLI::App& parent) {
                        "in DIR) against the dataset's true correspondences: repeatability, "
                        "precision and recall at 1/3/5 px, localisation error");
   cmd->add_option("dataset", o->dataset, "Dataset directory (from wingman render)")->required();
-  cmd->add_option("dir", o->dir, "Directory holding keypoints/<agent>/<t_ns>.csv and matches/<pair_id>.csv")
+  cmd->add_option("dir", o->dir,
+                  "Directory holding keypoints/<agent>/<t_ns>.csv (a condition's under "
+                  "conditions/<condition>/keypoints/) and matches/<pair_id>.csv")
       ->required();
   cmd->add_option("--name", o->name, "The method's name in the table (default: DIR's name)");
   add_pair_options(cmd, o->pairs, true);

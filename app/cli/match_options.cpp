@@ -29,17 +29,21 @@ void add_pair_options(CLI::App* cmd, PairCli& p, bool with_file) {
   cmd->add_option("--gap", p.options.gaps, "Temporal pairs: frame k with frame k + GAP (repeatable)")
       ->capture_default_str()->check(CLI::Range(1, 1000000));
   cmd->add_flag("--no-cross", p.no_cross, "No cross-UAV pairs");
+  cmd->add_option("--condition", p.conditions,
+                  "NAME=DIR: the same flight rendered under another condition (repeatable); pairs with frame B "
+                  "from it, same-instant pairs included");
   add_step_limit(cmd, p.limit);
 }
 
 namespace {
 
-std::vector<frontend_bench::FramePair> all_pairs(const datasets::Dataset& ds, const PairCli& p) {
-  if (!p.file.empty()) return frontend_bench::read_pairs(p.file, ds);
+std::vector<frontend_bench::FramePair> all_pairs(const frontend_bench::Conditions& sets, const PairCli& p) {
+  const datasets::Dataset& ds = sets.reference();
+  if (!p.file.empty()) return frontend_bench::read_pairs(p.file, sets);
   frontend_bench::PairOptions o = p.options;
   o.cross = !p.no_cross;
   try {
-    auto pairs = frontend_bench::make_pairs(ds, o);
+    auto pairs = frontend_bench::make_pairs(sets, o);
     if (pairs.empty()) throw io::UsageError(fmt::format("{}: no frame pairs (too few frames for the gaps?)", ds.root.string()));
     return pairs;
   } catch (const std::invalid_argument& e) {
@@ -49,8 +53,25 @@ std::vector<frontend_bench::FramePair> all_pairs(const datasets::Dataset& ds, co
 
 }  // namespace
 
-std::vector<frontend_bench::FramePair> load_pairs(const datasets::Dataset& ds, const PairCli& p, bool quiet) {
-  std::vector<frontend_bench::FramePair> pairs = all_pairs(ds, p);
+frontend_bench::Conditions load_conditions(const datasets::Dataset& reference, const PairCli& p) {
+  std::vector<frontend_bench::Condition> conditions;
+  for (const std::string& arg : p.conditions) {
+    const auto eq = arg.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == arg.size())
+      throw io::UsageError(fmt::format("--condition {}: expected NAME=DIR (e.g. low_sun=results/cond/low_sun)", arg));
+    conditions.push_back({arg.substr(0, eq), datasets::read_dataset(arg.substr(eq + 1))});
+  }
+  try {
+    return frontend_bench::Conditions(reference, std::move(conditions));
+  } catch (const std::invalid_argument& e) {
+    throw io::UsageError(fmt::format("--condition: {}", e.what()));
+  }
+}
+
+std::vector<frontend_bench::FramePair> load_pairs(const frontend_bench::Conditions& sets, const PairCli& p,
+                                                  bool quiet) {
+  const datasets::Dataset& ds = sets.reference();
+  std::vector<frontend_bench::FramePair> pairs = all_pairs(sets, p);
   const auto seconds = p.limit.seconds(ds.info.rate);
   if (!seconds) return pairs;
   std::int64_t t0 = std::numeric_limits<std::int64_t>::max();

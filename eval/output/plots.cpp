@@ -431,12 +431,14 @@ fs::path plot_monte_carlo_nees(const std::vector<MonteCarloSummary>& summaries, 
   return make_plot(dir, "montecarlo_nees", body + plot + "\n", 1100, 500);
 }
 
+// One colour per method of the matching benchmark's plots.
+constexpr const char* kMethodColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"};
+
 fs::path plot_match_curves(const std::vector<std::string>& methods, const fs::path& dir) {
   if (methods.empty()) throw std::invalid_argument("plot_match_curves: nothing to plot");
   if (!fs::is_regular_file(dir / "curves.csv"))
     throw std::runtime_error("cannot draw the match curves: " + (dir / "curves.csv").string() + " does not exist");
   fs::create_directories(dir / "plots");
-  static const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"};
   static const char* panels[][2] = {{"precision", "matching precision"},
                                     {"recall", "matching recall"},
                                     {"repeatability", "repeatability"}};
@@ -448,17 +450,48 @@ fs::path plot_match_curves(const std::vector<std::string>& methods, const fs::pa
     for (std::size_t m = 0; m < methods.size(); ++m)
       for (const char* type : {"temporal", "cross"}) {
         s += fmt::format(
-            "{}'curves.csv' using (column('threshold_px')):((strcol('method') eq {} && "
-            "strcol('type') eq '{}' && strcol('baseline') eq 'all') ? {} : NaN) with linespoints "
+            "{}'curves.csv' using (column('threshold_px')):((strcol('method') eq {} && strcol('condition') eq "
+            "'reference' && strcol('type') eq '{}' && strcol('baseline') eq 'all') ? {} : NaN) with linespoints "
             "lw 1.5 pt 7 ps 0.6 dt {} lc rgb '{}' title {}",
             m == 0 && type[0] == 't' ? "" : ", \\\n     ", gq(methods[m]), type, col(column),
-            type[0] == 't' ? 1 : 2, colours[m % std::size(colours)],
+            type[0] == 't' ? 1 : 2, kMethodColours[m % std::size(kMethodColours)],
             gq(methods[m] + " " + type));
       }
     s += "\n";
   }
   s += "unset multiplot\n";
   return make_plot(dir, "match_curves", s, 1800, 600);
+}
+
+fs::path plot_conditions(const std::vector<std::string>& methods, const std::vector<std::string>& conditions,
+                         double threshold_px, const fs::path& dir) {
+  if (methods.empty() || conditions.empty()) throw std::invalid_argument("plot_conditions: nothing to plot");
+  if (!fs::is_regular_file(dir / "conditions.csv"))
+    throw std::runtime_error("cannot draw the conditions: " + (dir / "conditions.csv").string() + " does not exist");
+  fs::create_directories(dir / "plots");
+  std::string tics;
+  for (std::size_t i = 0; i < conditions.size(); ++i) tics += fmt::format("{}{} {}", i ? ", " : "", gq(conditions[i]), i);
+  std::string s = fmt::format(
+      "set multiplot layout 1,3 title {}\nset xtics ({}) rotate by -30\nset xrange [-0.5:{}]\nset yrange [0:1]\n"
+      "set key bottom left opaque box\n",
+      gq(fmt::format("Feature frontends per condition at {:g} px (solid: same instant, dashed: temporal, dotted: "
+                     "cross-UAV pairs)", threshold_px)),
+      tics, static_cast<double>(conditions.size()) - 0.5);
+  for (const char* column : {"precision", "recall", "repeatability"}) {
+    // One key, on the precision panel, whose lines lie highest: the key would hide the others' lines.
+    if (column[0] == 'r') s += "unset key\n";
+    s += fmt::format("set title {}\nset ylabel {}\nplot ", gq(column), gq(column));
+    for (std::size_t m = 0; m < methods.size(); ++m)
+      for (const auto& [type, dash] : {std::pair{"same-instant", 1}, std::pair{"temporal", 2}, std::pair{"cross", 3}})
+        s += fmt::format(
+            "{}'conditions.csv' using (column('condition_index')):((strcol('method') eq {} && strcol('type') eq '{}') ? "
+            "{} : NaN) with linespoints lw 1.5 pt 7 ps 0.6 dt {} lc rgb '{}' title {}",
+            m == 0 && dash == 1 ? "" : ", \\\n     ", gq(methods[m]), type, col(column), dash,
+            kMethodColours[m % std::size(kMethodColours)], gq(methods[m] + " " + type));
+    s += "\n";
+  }
+  s += "unset multiplot\n";
+  return make_plot(dir, "conditions", s, 1800, 600);
 }
 
 }  // namespace wingman::eval

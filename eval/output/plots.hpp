@@ -47,4 +47,13 @@ std::filesystem::path plot_monte_carlo_nees(const std::vector<MonteCarloSummary>
 std::filesystem::path plot_match_curves(const std::vector<std::string>& methods,
                                         const std::filesystem::path& dir);
 
+// The matching benchmark per condition (docs/frontend.md, conditions): precision, recall and
+// repeatability at threshold_px against the condition (conditions[0] the reference), one line per
+// method and pair type (solid: same-instant, dashed: temporal, dotted: cross-UAV), in
+// <dir>/plots/conditions.png and .gp, reading <dir>/conditions.csv (columns method, type,
+// condition_index, condition, pairs, threshold_px, precision, recall, repeatability).
+std::filesystem::path plot_conditions(const std::vector<std::string>& methods,
+                                      const std::vector<std::string>& conditions, double threshold_px,
+                                      const std::filesystem::path& dir);
+
 }  // namespace wingman::eval

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "datasets/dataset.hpp"
 
@@ -148,6 +149,38 @@ TEST(Dataset, DistortionIsWrittenWithTheCountItsModelTakes) {
   EXPECT_DOUBLE_EQ(read_dataset(a.path).agent("uav1").camera->camera.distortion().k3, 0);
   // T_BS: the nominal mount, R_BS = R_CW^T and the offset.
   EXPECT_NE(radtan.find("data: [1, 0, 0, 0.1, 0, -1, 0, 0, 0, 0, -1, -0.05, 0, 0, 0, 1]"), std::string::npos) << radtan;
+}
+
+TEST(Dataset, TheShutterIsReadBackAndABadOneNamesTheFile) {
+  TempDir a;
+  write_small(a.path);
+  EXPECT_FALSE(read_dataset(a.path).agent("uav1").camera->rolling);
+  const fs::path yaml = a.path / "uav1" / "mav0" / "cam0" / "sensor.yaml";
+  const std::string global = slurp(yaml);
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = global;
+    const auto pos = s.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    std::ofstream(yaml) << s.replace(pos, from.size(), to);
+  };
+  with("  type: global\n  exposure_s: 0\n  line_delay_s: 0\n  readout: top_to_bottom",
+       "  type: rolling\n  exposure_s: 0\n  line_delay_s: 3e-05\n  readout: bottom_to_top");
+  const CameraInfo c = *read_dataset(a.path).agent("uav1").camera;
+  EXPECT_TRUE(c.rolling);
+  EXPECT_DOUBLE_EQ(c.line_delay_s, 3e-5);
+  EXPECT_FALSE(c.top_to_bottom);
+  for (const auto& [from, to, message] :
+       {std::tuple{"  type: global", "  type: sideways", "shutter.type 'sideways': expected global or rolling"},
+        std::tuple{"  type: global", "  type: rolling", "shutter.line_delay_s must be above 0 for a rolling shutter"},
+        std::tuple{"  line_delay_s: 0", "  line_delay_s: 0.5", "shutter.line_delay_s 0.5 must be in [0, 0.001]"}}) {
+    with(from, to);
+    try {
+      read_dataset(a.path);
+      ADD_FAILURE() << to;
+    } catch (const DatasetError& e) {
+      EXPECT_EQ(std::string(e.what()), yaml.string() + ": " + message);
+    }
+  }
 }
 
 TEST(Dataset, GrayFramesRoundTrip) {

@@ -15,8 +15,7 @@ inline FrameTruth nadir_frame(const Eigen::Vector3d& centre, geometry::Distortio
                               double yaw = 0) {
   FrameTruth f;
   f.camera = geometry::PinholeCamera(50, 50, 49.5, 49.5, 100, 100, dist);
-  f.R_CW = geometry::nadir_R_CW() * geometry::rot_z(yaw).transpose();
-  f.centre = centre;
+  f.pose = geometry::CameraPose{geometry::nadir_R_CW() * geometry::rot_z(yaw).transpose(), centre};
   f.depth = cv::Mat(100, 100, CV_32F, cv::Scalar(centre.z()));
   return f;
 }

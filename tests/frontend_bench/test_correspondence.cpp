@@ -61,7 +61,7 @@ TEST(TrueCorrespondence, NoSurfaceOutsideImageAndBehindCameraHaveNoCorrespondenc
   EXPECT_EQ(true_correspondence(a, b, {60, 40}).status, CorrespondenceStatus::NoDepth);
   EXPECT_EQ(true_correspondence(a, b, {60.3, 39.8}).status, CorrespondenceStatus::NoDepth);  // nearest pixel
   FrameTruth up = nadir_frame({2, 0, 10});
-  up.R_CW = Eigen::Matrix3d::Identity();  // optical axis along world +z, away from the ground
+  up.pose = geometry::CameraPose{Eigen::Matrix3d::Identity(), {2, 0, 10}};  // optical axis up, away from the ground
   EXPECT_EQ(true_correspondence(nadir_frame({0, 0, 10}), up, {60, 40}).status,
             CorrespondenceStatus::BehindCamera);
   // No surface in B at the projection: nothing is seen there.
@@ -86,7 +86,7 @@ TEST(TrueCorrespondence, RoundTripThroughDistortedYawedCamerasReturnsThePixel) {
     ASSERT_TRUE(ba.found());
     EXPECT_NEAR((ba.uv_b - uv).norm(), 0.0, 1e-6) << uv.transpose();
     // The distortion is applied: the undistorted projection differs.
-    const Eigen::Vector3d p_B = b.R_CW * (ab.point_W - b.centre);
+    const Eigen::Vector3d p_B = b.pose.centre().to_camera(ab.point_W);
     const Eigen::Vector2d pinhole(50 * p_B.x() / p_B.z() + 49.5, 50 * p_B.y() / p_B.z() + 49.5);
     if ((pinhole - Eigen::Vector2d(49.5, 49.5)).norm() > 30) {
       EXPECT_GT((pinhole - ab.uv_b).norm(), 0.5);

@@ -150,5 +150,107 @@ TEST(FramePairs, PairsFileRoundTripsAndAFrameTheDatasetLacksIsNamed) {
   EXPECT_NE(error_of([&] { read_pairs(dir.path() / "dup.csv", ds); }).find("dup.csv:3: pair_id 0"), std::string::npos);
 }
 
+// two_uavs() again, as rendered under condition `name` into /data/<name>.
+Condition condition(const std::string& name) {
+  Condition c{name, two_uavs()};
+  c.dataset.root = "/data/" + name;
+  return c;
+}
+
+TEST(FramePairs, ConditionPairsFollowTheReferencesWithSameInstantPairsFirst) {
+  const auto ds = two_uavs();
+  const Conditions sets(ds, {condition("blur")});
+  PairOptions o;
+  o.stride = 2;
+  o.gaps = {1, 2};
+  const auto pairs = make_pairs(sets, o);
+  // The reference's 6 (k = 0: 2 UAVs x 2 gaps + cross; k = 2: cross), then blur's: k = 0 per UAV
+  // same-instant + 2 gaps, cross; k = 2 per UAV same-instant, cross.
+  ASSERT_EQ(pairs.size(), 6u + 7u + 3u);
+  EXPECT_EQ(pairs[5].condition, kReference);
+  EXPECT_EQ(pairs[6].condition, "blur");
+  EXPECT_EQ(pairs[6].type, PairType::SameInstant);
+  EXPECT_EQ(pairs[6].t_a, pairs[6].t_b);
+  EXPECT_NEAR(pairs[6].baseline_m, 0.0, 1e-12);
+  EXPECT_EQ(pairs[7].type, PairType::Temporal);
+  EXPECT_NEAR(pairs[7].baseline_m, 0.4, 1e-12);
+  EXPECT_EQ(pairs[12].type, PairType::Cross);
+  EXPECT_EQ(pairs[13].type, PairType::SameInstant);
+  EXPECT_EQ(pairs[15].id, 15);
+  const std::string csv = pairs_csv(pairs);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m,condition");
+  EXPECT_NE(csv.find("\n6,uav1,0,uav1,0,same-instant,0.0000,blur\n"), std::string::npos) << csv;
+  io::test::TempDir dir;
+  write(dir.path() / "pairs.csv", csv);
+  const auto back = read_pairs(dir.path() / "pairs.csv", sets);
+  ASSERT_EQ(back.size(), pairs.size());
+  EXPECT_EQ(back[13].condition, "blur");
+  EXPECT_EQ(back[13].type, PairType::SameInstant);
+  EXPECT_EQ(keypoints_file(dir.path(), "blur", "uav2", 100), dir.path() / "conditions" / "blur" / "keypoints" / "uav2" / "100.csv");
+  EXPECT_EQ(keypoints_file(dir.path(), kReference, "uav2", 100), keypoints_file(dir.path(), "uav2", 100));
+}
+
+TEST(FramePairs, ASevenColumnPairsFileIsTheReferencesPairs) {
+  io::test::TempDir dir;
+  const auto ds = two_uavs();
+  write(dir.path() / "old.csv", "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m\n"
+                                "0,uav1,0,uav1,200000000,temporal,0\n3,uav1,100000000,uav2,100000000,cross,0\n");
+  const auto pairs = read_pairs(dir.path() / "old.csv", Conditions(ds, {condition("blur")}));
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_EQ(pairs[0].condition, kReference);
+  EXPECT_EQ(pairs[1].condition, kReference);
+  EXPECT_EQ(pairs[1].id, 3);
+  EXPECT_NEAR(pairs[0].baseline_m, 0.8, 1e-12);
+  EXPECT_NEAR(pairs[1].baseline_m, 3.0, 1e-12);
+}
+
+TEST(FramePairs, AnUnknownConditionOrAReferenceSameInstantPairIsNamedWithFileAndLine) {
+  io::test::TempDir dir;
+  const auto ds = two_uavs();
+  const Conditions sets(ds, {condition("blur")});
+  const std::string header = "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m,condition\n";
+  write(dir.path() / "p.csv", header + "0,uav1,0,uav1,0,same-instant,0,blur\n1,uav1,0,uav1,0,same-instant,0,fog\n");
+  EXPECT_EQ(error_of([&] { read_pairs(dir.path() / "p.csv", sets); }),
+            (dir.path() / "p.csv").string() + ":3: condition 'fog' is none of the datasets given (reference, blur; "
+                                              "a condition is given as --condition NAME=DIR)");
+  write(dir.path() / "q.csv", header + "0,uav1,0,uav1,0,same-instant,0,reference\n");
+  EXPECT_NE(error_of([&] { read_pairs(dir.path() / "q.csv", sets); }).find("q.csv:2: a same-instant pair is one UAV's"),
+            std::string::npos);
+  write(dir.path() / "r.csv", header + "0,uav1,0,uav1,0,sideways,0,blur\n");
+  EXPECT_NE(error_of([&] { read_pairs(dir.path() / "r.csv", sets); }).find("r.csv:2: type must be temporal, cross or same-instant"),
+            std::string::npos);
+}
+
+TEST(Conditions, AConditionWhosePosesOrFramesDifferIsNamedWithFileAndLine) {
+  const auto ds = two_uavs();
+  auto dataset_error = [&](const Condition& c) {
+    try {
+      Conditions(ds, {c});
+    } catch (const datasets::DatasetError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(dataset_error(condition("blur")), "");
+  Condition moved = condition("moved");
+  moved.dataset.agents[1].camera_pose[1].p.x() += 1e-6;
+  EXPECT_EQ(dataset_error(moved), "/data/moved/uav2/mav0/cam0_pose0/data.csv:3: condition moved does not image the "
+                                  "reference /data/ds: the true camera pose at t_ns 100000000 differs from the "
+                                  "reference's by 1e-06 (more than 1e-09)");
+  Condition late = condition("late");
+  late.dataset.agents[0].frames[2] += 1;
+  EXPECT_NE(dataset_error(late).find("/data/late/uav1/mav0/cam0/data.csv:4: condition late does not image the reference "
+                                     "/data/ds: frame 2 is at t_ns 200000001, the reference's at 200000000"),
+            std::string::npos);
+  Condition one = condition("one");
+  one.dataset.agents.pop_back();
+  EXPECT_NE(dataset_error(one).find("/data/one/dataset.yaml: condition one does not image the reference /data/ds: its "
+                                    "cameras are on [uav1], the reference's on [uav1, uav2]"),
+            std::string::npos);
+  EXPECT_THROW(Conditions(ds, {condition("reference")}), std::invalid_argument);
+  EXPECT_THROW(Conditions(ds, {condition("a/b")}), std::invalid_argument);
+  EXPECT_THROW(Conditions(ds, {condition("blur"), condition("blur")}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace wingman::frontend_bench

@@ -105,5 +105,32 @@ TEST(GroupScores, PoolsCountsPerPairTypeAndBaselineBin) {
   EXPECT_EQ(g[5].counts.correct[2], 5);
 }
 
+TEST(GroupScores, GroupsEachConditionByTypeAfterTheReference) {
+  const ScoreOptions o = one_three_five();
+  std::vector<FramePair> pairs{{0, "uav1", 0, "uav1", 1, PairType::Temporal, 0.2, "blur"},
+                               {1, "uav1", 0, "uav1", 0, PairType::SameInstant, 0, "blur"},
+                               {2, "uav1", 0, "uav1", 1, PairType::Temporal, 0.2, kReference},
+                               {3, "uav1", 0, "uav1", 0, PairType::SameInstant, 0, "noise"}};
+  std::vector<MatchCounts> counts(4, MatchCounts(3));
+  for (int i = 0; i < 4; ++i) {
+    counts[i].pairs = 1;
+    counts[i].matches = 10 * (i + 1);
+  }
+  const auto g = group_scores(pairs, counts, o);
+  // reference: all, temporal, its bin; blur: all, temporal, bin, same-instant, bin; noise: all, same-instant, bin.
+  ASSERT_EQ(g.size(), 11u);
+  EXPECT_EQ(g[0].condition, kReference);
+  EXPECT_EQ(g[0].counts.matches, 30);
+  EXPECT_EQ(g[3].condition, "blur");
+  EXPECT_EQ(g[3].type, "all");
+  EXPECT_EQ(g[3].counts.matches, 30);
+  EXPECT_EQ(g[6].type, "same-instant");
+  EXPECT_EQ(g[6].counts.matches, 20);
+  EXPECT_EQ(g[7].baseline, "0-0.5 m");
+  EXPECT_EQ(g[8].condition, "noise");
+  EXPECT_EQ(g[9].type, "same-instant");
+  EXPECT_EQ(g[10].counts.matches, 40);
+}
+
 }  // namespace
 }  // namespace wingman::frontend_bench

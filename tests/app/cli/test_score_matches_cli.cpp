@@ -13,47 +13,31 @@
 #include <nlohmann/json.hpp>
 
 #include "app/app_test_support.hpp"
+#include "app/cli/rendered_suite.hpp"
 #include "datasets/dataset.hpp"
 #include "frontend_bench/correspondence.hpp"
 #include "frontend_bench/match_files.hpp"
-#include "gl_required.hpp"
 
 namespace wingman::app::test {
 namespace {
 
 using ::testing::HasSubstr;
 
-class ScoreMatchesCli : public ::testing::Test {
- protected:
+class ScoreMatchesCli : public RenderedSuite<ScoreMatchesCli> {
+ public:
   // One dataset for the suite: rendering is the slow part.
-  static void SetUpTestSuite() {
-    std::string why;
-    if (!wingman::testing::gl_available(&why)) {
-      skip_reason_ = why;
-      return;
-    }
-    dir_ = new TempDir();
-    const RunResult r = run_wingman({"render", "scenes/rendered_smoke.yaml", "--variant", "multi",
-                                     "--frames", "11", "--quiet", "--out", ds().string()},
-                                    dir_->path());
-    if (r.exit_code != 0) render_error_ = r.output;
+  static std::string render(const fs::path& dir) {
+    const RunResult r = run_wingman({"render", "scenes/rendered_smoke.yaml", "--variant", "multi", "--frames", "11",
+                                     "--quiet", "--out", (dir / "ds").string()},
+                                    dir);
+    return r.exit_code == 0 ? "" : r.output;
   }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  void SetUp() override {
-    if (!skip_reason_.empty()) WINGMAN_NO_GL_CONTEXT(skip_reason_);
-    ASSERT_TRUE(render_error_.empty()) << render_error_;
-  }
-  static fs::path ds() { return dir_->path() / "ds"; }
-  static fs::path tmp() { return dir_->path(); }
 
-  static inline TempDir* dir_ = nullptr;
-  static inline std::string skip_reason_, render_error_;
+ protected:
+  static fs::path ds() { return tmp() / "ds"; }
 };
 
-const char* kPairsHeader = "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m\n";
+const char* kPairsHeader = "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m\n";  // the reference-only columns
 
 // Two pairs: uav1 at 0 s and 0.5 s (temporal), uav1 and uav2 at 0 s (cross).
 std::string two_pairs() {
@@ -126,12 +110,14 @@ TEST_F(ScoreMatchesCli, PairsListsTemporalAndCrossPairsWithBaselines) {
   // 11 frames, stride 10, gaps 1, 5, 10: per UAV three temporal pairs from frame 0; cross pairs at
   // frames 0 and 10.
   ASSERT_EQ(lines.size(), 9u) << r.output;
-  EXPECT_EQ(lines[0] + "\n", kPairsHeader);
+  EXPECT_EQ(lines[0], "pair_id,agent_a,t_ns_a,agent_b,t_ns_b,type,baseline_m,condition");
   EXPECT_THAT(lines[1], ::testing::StartsWith("0,uav1,0,uav1,100000000,temporal,"));
   EXPECT_THAT(lines[7], ::testing::StartsWith("6,uav1,0,uav2,0,cross,"));
   EXPECT_THAT(lines[8], ::testing::StartsWith("7,uav1,1000000000,uav2,1000000000,cross,"));
   // The UAVs fly 3 m apart horizontally and 2 m vertically at the start.
-  const double baseline = std::stod(lines[7].substr(lines[7].rfind(',') + 1));
+  EXPECT_THAT(lines[7], ::testing::EndsWith(",reference"));
+  const std::string before_condition = lines[7].substr(0, lines[7].rfind(','));
+  const double baseline = std::stod(before_condition.substr(before_condition.rfind(',') + 1));
   EXPECT_NEAR(baseline, std::sqrt(3.0 * 3.0 + 2.0 * 2.0), 0.3);
 }
 

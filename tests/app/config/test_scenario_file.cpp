@@ -445,6 +445,28 @@ variants:
   EXPECT_EQ(all[1].phases.size(), 1u);
 }
 
+TEST(ScenarioYaml, AVariantMayLightTheWorldOtherwiseButNotMoveIt) {
+  const auto all = parse_scenarios(doc(R"(
+world: {light: {ambient: 0.3}, objects: {trees: 5}}
+variants:
+  - name: ideal
+  - name: low_sun
+    world: {light: {sun: {enabled: true, time_utc: 7.9}, shadows: true}}
+)"), "scn.yaml");
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_FALSE(all[0].world.light.sun.enabled);
+  EXPECT_TRUE(all[1].world.light.sun.enabled);
+  EXPECT_DOUBLE_EQ(all[1].world.light.sun.time_utc, 7.9);
+  EXPECT_TRUE(all[1].world.light.shadows);
+  EXPECT_DOUBLE_EQ(all[1].world.light.ambient, 0.3);  // the base's light, key by key
+  EXPECT_DOUBLE_EQ(all[1].world.objects.trees, all[0].world.objects.trees);
+  EXPECT_THAT(error_of("variants:\n  - {name: a, world: {objects: {trees: 1}}}\n"),
+              HasSubstr("scn.yaml:2:23: variants[0].world.objects: unknown key 'objects' (a variant may set only "
+                        "world.light)"));
+  EXPECT_THAT(error_of("variants:\n  - {name: a, world: {light: {sun: {enabled: true, time_utc: 2}}}}\n"),
+              HasSubstr("the sun is below the horizon"));
+}
+
 TEST(ScenarioYaml, VariantErrors) {
   const std::string y = doc(R"(
 variants:
