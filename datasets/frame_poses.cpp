@@ -56,8 +56,7 @@ geometry::CameraPose camera_pose(const Eigen::Quaterniond& q_CW, const Eigen::Ve
 
 double row_time(const CameraInfo& c, double row) {
   if (!c.rolling) return 0;
-  const double from_centre = row - (c.camera.height() - 1) / 2.0;
-  return (c.top_to_bottom ? 1 : -1) * from_centre * c.line_delay_s;
+  return geometry::rolling_row_time(row, c.camera.height(), c.line_delay_s, c.top_to_bottom);
 }
 
 geometry::FramePoses frame_poses(const AgentData& a, std::size_t k) {

@@ -6,6 +6,10 @@
 
 namespace wingman::geometry {
 
+double rolling_row_time(double row, int height, double line_delay, bool top_to_bottom) {
+  return (top_to_bottom ? 1 : -1) * (row - (height - 1) / 2.0) * line_delay;
+}
+
 FramePoses::FramePoses(const CameraPose& centre, std::vector<CameraPose> rows)
     : centre_(centre), rows_(std::move(rows)) {}
 

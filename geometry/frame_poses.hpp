@@ -11,6 +11,11 @@
 
 namespace wingman::geometry {
 
+// Seconds after the frame's time at which (fractional) row `row` of an image `height` rows high
+// is exposed by a rolling shutter that reads a row every `line_delay` s, top to bottom or bottom to
+// top: the middle row, (height - 1) / 2, is the frame's time.
+double rolling_row_time(double row, int height, double line_delay, bool top_to_bottom);
+
 class FramePoses {
  public:
   FramePoses() = default;

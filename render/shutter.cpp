@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "geometry/frame_poses.hpp"
 #include "render/linear_light.hpp"
 
 namespace wingman::render {
@@ -31,8 +32,7 @@ cv::Mat encode(const cv::Mat& sum, double scale) {
 
 double row_time(const sim::ShutterSpec& s, double row, int height) {
   if (!s.rolling()) return 0;
-  const double from_centre = row - (height - 1) / 2.0;
-  return (s.readout == sim::ShutterSpec::Readout::TopToBottom ? 1 : -1) * from_centre * s.line_delay;
+  return geometry::rolling_row_time(row, height, s.line_delay, s.readout == sim::ShutterSpec::Readout::TopToBottom);
 }
 
 Frame expose(const sim::ShutterSpec& s, double exposure_s, int width, int height, const BandRenderer& render) {
