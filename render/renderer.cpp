@@ -17,12 +17,10 @@ namespace wingman::render {
 
 namespace {
 
-// Lambert shading per vertex: the terrain's normals vary smoothly over its 2 m cells and the
-// objects are flat-shaded, so per-pixel lighting changed nothing visible, while llvmpipe's
-// fragment cost grows with every varying and instruction. The fragment shader is one texture
-// lookup times one colour. The light besides the sun's beam runs from u_bounce (a surface facing
-// down) to u_ambient (facing up); they are equal under the constant sky (render/skylight.hpp).
-const char* kSceneVs = R"(
+// What both colour programs' vertex shaders read, and the light besides the sun's beam on a face
+// of world normal n: from u_bounce (facing down) to u_ambient (facing up); the two are equal under
+// the constant sky (render/skylight.hpp).
+const char* kVertexInputs = R"(
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
@@ -36,11 +34,18 @@ uniform vec3 u_bounce;
 uniform vec3 u_diffuse;
 uniform bool u_unlit;
 out vec2 v_uv;
+vec3 sky(vec3 n) { return u_bounce + (u_ambient - u_bounce) * (0.5 + 0.5 * n.z); }
+)";
+
+// Lambert shading per vertex: the terrain's normals vary smoothly over its 2 m cells and the
+// objects are flat-shaded, so per-pixel lighting changed nothing visible, while llvmpipe's
+// fragment cost grows with every varying and instruction. The fragment shader is one texture
+// lookup times one colour.
+const char* kSceneVs = R"(
 out vec3 v_colour;
 void main() {
   vec3 n = normalize(u_model_rot * a_normal);
-  vec3 shade = u_unlit ? vec3(1.0)
-      : u_bounce + (u_ambient - u_bounce) * (0.5 + 0.5 * n.z) + u_diffuse * max(dot(n, u_to_light), 0.0);
+  vec3 shade = u_unlit ? vec3(1.0) : sky(n) + u_diffuse * max(dot(n, u_to_light), 0.0);
   v_uv = a_uv;
   v_colour = a_colour * shade;
   gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
@@ -61,24 +66,11 @@ void main() {
 // percentage-closer filtering by the sampler's compare mode). A program of its own, so that a
 // world without shadows runs exactly the programs above.
 const char* kShadowedVs = R"(
-layout(location = 0) in vec3 a_pos;
-layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec2 a_uv;
-layout(location = 3) in vec3 a_colour;
-uniform mat4 u_model_view;
-uniform mat4 u_proj;
-uniform mat3 u_model_rot;
 uniform mat4 u_light_from_model;
 uniform mat4 u_model;
-uniform vec3 u_to_light;
-uniform vec3 u_ambient;
-uniform vec3 u_bounce;
-uniform vec3 u_diffuse;
-uniform bool u_unlit;
 uniform vec2 u_cloud_offset;  // m the clouds have drifted
 uniform float u_cloud_period;  // m the cloud texture spans
 uniform float u_cloud_height;
-out vec2 v_uv;
 out vec3 v_ambient;
 out vec3 v_direct;
 out vec4 v_light;
@@ -90,7 +82,7 @@ void main() {
   vec3 n = normalize(u_model_rot * a_normal);
   vec3 direct = u_unlit ? vec3(0.0) : u_diffuse * max(dot(n, u_to_light), 0.0);
   v_uv = a_uv;
-  v_ambient = a_colour * (u_unlit ? vec3(1.0) : u_bounce + (u_ambient - u_bounce) * (0.5 + 0.5 * n.z));
+  v_ambient = a_colour * (u_unlit ? vec3(1.0) : sky(n));
   v_direct = a_colour * direct;
   v_light = u_light_from_model * vec4(a_pos, 1.0);
   gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
@@ -667,7 +659,8 @@ struct Renderer::Impl {
 ColourProgram Renderer::Impl::make_colour_program(bool shadowed, bool stochastic) {
   ColourProgram p;
   const char* lookup = stochastic ? kStochasticLookup : kImageLookup;
-  p.id = shadowed ? link({kShadowedVs}, {lookup, kShadowedFs}) : link({kSceneVs}, {lookup, kSceneFs});
+  p.id = shadowed ? link({kVertexInputs, kShadowedVs}, {lookup, kShadowedFs})
+                  : link({kVertexInputs, kSceneVs}, {lookup, kSceneFs});
   for (auto [loc, name] : {std::pair{&p.model_view, "u_model_view"}, {&p.proj, "u_proj"}, {&p.model_rot, "u_model_rot"},
                            {&p.tex, "u_tex"}, {&p.to_light, "u_to_light"}, {&p.ambient, "u_ambient"},
                            {&p.bounce, "u_bounce"}, {&p.diffuse, "u_diffuse"}, {&p.unlit, "u_unlit"},
