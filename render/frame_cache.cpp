@@ -165,7 +165,7 @@ FrameKeyer::FrameKeyer(const Scene& scene, std::string_view salt) {
     if (m.stochastic_cell > 0)  // hashed only when on
       hash_doubles(s.get(), {m.stochastic_cell, m.blend_sharpness, double(m.stochastic_seed)});
   }
-  for (const auto* meshes : {&scene.static_meshes, &scene.lead_meshes}) {
+  for (const auto* meshes : {&scene.static_meshes, &scene.lead_meshes, &scene.body_meshes}) {
     hash_doubles(s.get(), {double(meshes->size())});
     for (const Mesh& m : *meshes) {
       hash_vector(s.get(), m.positions);
@@ -204,6 +204,7 @@ FrameKey FrameKeyer::key(const CameraView& view, const std::optional<LeadPose>& 
   v.insert(v.end(), R.data(), R.data() + 9);
   v.insert(v.end(), p.data(), p.data() + 3);
   if (lead) v.insert(v.end(), {1.0, lead->position.x(), lead->position.y(), lead->position.z(), lead->yaw});
+  for (const LeadPose& b : view.bodies) v.insert(v.end(), {2.0, b.position.x(), b.position.y(), b.position.z(), b.yaw});
   if (timed_) v.push_back(view.time);
   std::vector<std::uint8_t> bytes(sizeof scene + v.size() * sizeof(double));
   std::memcpy(bytes.data(), scene, sizeof scene);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "render/gl_functions.hpp"
+#include "render/piece_table.hpp"
 #include "render/skylight.hpp"
 
 namespace wingman::render {
@@ -116,33 +117,22 @@ vec3 surface(vec2 uv) { return texture(u_tex, uv).rgb; }
 
 // Stochastic tiling (world.texture.tiling; Heitz & Neyret 2018, in the form of Deliot & Heitz
 // 2019): an equilateral triangle grid over the texture's plane; each grid vertex shows the piece
-// of the image around a centre drawn for it (an integer hash, the same on every GL), kept at least
-// a cell from the image's border so that no piece ever wraps over a seam; each pixel blends the
-// three pieces of its triangle with sharpened barycentric weights, about the image's mean and
-// divided by the weights' norm so that the blend keeps the image's variance. The gradients of the
-// plain coordinate pick the mipmap level (each piece is the same coordinate shifted).
+// of the image around its centre in u_pieces (render/piece_table.hpp: chosen so that nearby
+// vertices never show copies of the same ground a short way apart, and at least a cell from the
+// image's border so that no piece ever wraps over a seam); each pixel blends the three pieces of
+// its triangle with sharpened barycentric weights, about the image's mean and divided by the
+// weights' norm so that the blend keeps the image's variance. The gradients of the plain
+// coordinate pick the mipmap level (each piece is the same coordinate shifted).
 const char* kStochasticLookup = R"(
 uniform sampler2D u_tex;
-uniform float u_cell;       // grid side, in units of the texture's width
-uniform float u_aspect;     // the texture's height over its width
-uniform float u_sharpness;  // power of the blend weights
-uniform vec3 u_mean;        // the image's mean colour
-uniform uint u_seed;
-uvec2 pcg2d(uvec2 v) {
-  v = v * 1664525u + 1013904223u;
-  v.x += v.y * 1664525u;
-  v.y += v.x * 1664525u;
-  v = v ^ (v >> 16u);
-  v.x += v.y * 1664525u;
-  v.y += v.x * 1664525u;
-  v = v ^ (v >> 16u);
-  return v;
-}
+uniform float u_cell;         // grid side, in units of the texture's width
+uniform float u_aspect;       // the texture's height over its width
+uniform float u_sharpness;    // power of the blend weights
+uniform vec3 u_mean;          // the image's mean colour
+uniform sampler2D u_pieces;   // RG32F: each vertex's piece centre, periodic, a power of two wide
 // The shift from the coordinate of vertex `id` to where its piece lies in the image.
 vec2 piece_shift(ivec2 id) {
-  vec2 r = vec2(pcg2d(uvec2(id) + uvec2(u_seed, 3u * u_seed + 1u)) >> 8u) / 16777216.0;
-  float lo = u_cell * 1.02;
-  vec2 centre = vec2(lo) + r * (vec2(1.0, u_aspect) - 2.0 * vec2(lo));
+  vec2 centre = texelFetch(u_pieces, id & (textureSize(u_pieces, 0) - 1), 0).rg;
   vec2 at = u_cell * vec2(float(id.x) + 0.5 * float(id.y), 0.8660254 * float(id.y));
   return centre - at;
 }
@@ -262,7 +252,7 @@ struct GpuMaterial {
   // Stochastic tiling (kStochasticLookup); cell 0: the texture as it is.
   float cell = 0, aspect = 1, sharpness = 1;
   Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-  GLuint seed = 0;
+  GLuint pieces = 0;  // the piece table's texture
 };
 
 // The uniform locations of one colour program; -1 for those it lacks (glUniform ignores them).
@@ -272,7 +262,7 @@ struct ColourProgram {
         diffuse = -1, unlit = -1;
   GLint light_from_model = -1, shadow = -1, zero_to_one = -1, model = -1, cloud_tex = -1, cloud_offset = -1,
         cloud_period = -1, cloud_height = -1, cloud_block = -1;
-  GLint cell = -1, aspect = -1, sharpness = -1, mean = -1, seed = -1;
+  GLint cell = -1, aspect = -1, sharpness = -1, mean = -1, pieces = -1;
 };
 
 struct Target {
@@ -337,7 +327,8 @@ struct Renderer::Impl {
     double time = 0;  // s of the frame being drawn
   } sh;
   std::vector<GpuMaterial> materials;
-  std::vector<GpuMesh> static_meshes, lead_meshes;
+  std::vector<GpuMesh> static_meshes, lead_meshes, body_meshes;
+  std::vector<Eigen::Matrix4d> body_models;  // this render's UAV bodies (CameraView::bodies)
   std::map<std::pair<int, int>, Target> targets;
   std::vector<GLsizei> draw_counts;  // per-frame draw ranges, kept to avoid reallocating
   std::vector<const void*> draw_offsets;
@@ -422,9 +413,22 @@ struct Renderer::Impl {
       g.sharpness = static_cast<float>(m.blend_sharpness);
       const cv::Scalar mean = cv::mean(m.texture);
       g.mean = Eigen::Vector3f(mean[0], mean[1], mean[2]) / 255.f;
-      g.seed = m.stochastic_seed;
+      const double aspect = static_cast<double>(m.texture.rows) / m.texture.cols;
+      g.pieces = upload_pieces(piece_table(m.stochastic_cell * std::min(1.0, aspect), aspect, m.stochastic_seed));
     }
     return g;
+  }
+
+  // The piece table as an RG32F texture read with texelFetch (no filtering, no mipmaps).
+  GLuint upload_pieces(const PieceTable& t) {
+    GLuint x = 0;
+    gl.GenTextures(1, &x);
+    gl.BindTexture(GL_TEXTURE_2D, x);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RG32F, PieceTable::kSize, PieceTable::kSize, 0, GL_RG, GL_FLOAT,
+                  t.centres.data());
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return x;
   }
 
   // cell: chunk size in metres; 0 for one chunk (the lead, which moves).
@@ -509,6 +513,7 @@ struct Renderer::Impl {
     const Pass pass{colour, P, V, light};
     draw_meshes(pass, static_meshes, Eigen::Matrix4d::Identity());
     if (lead_model) draw_meshes(pass, lead_meshes, *lead_model);
+    for (const Eigen::Matrix4d& M : body_models) draw_meshes(pass, body_meshes, M);
   }
 
   struct Pass {
@@ -563,7 +568,10 @@ struct Renderer::Impl {
       gl.Uniform1f(p.aspect, mat->aspect);
       gl.Uniform1f(p.sharpness, mat->sharpness);
       gl.Uniform3fv(p.mean, 1, mat->mean.data());
-      gl.Uniform1ui(p.seed, mat->seed);
+      gl.Uniform1i(p.pieces, 3);
+      gl.ActiveTexture(GL_TEXTURE3);
+      gl.BindTexture(GL_TEXTURE_2D, mat->pieces);
+      gl.ActiveTexture(GL_TEXTURE0);
     }
   }
 
@@ -636,13 +644,16 @@ struct Renderer::Impl {
       gl.DeleteFramebuffers(2, fbos);
       gl.DeleteRenderbuffers(4, rbs);
     }
-    for (auto* list : {&static_meshes, &lead_meshes})
+    for (auto* list : {&static_meshes, &lead_meshes, &body_meshes})
       for (auto& m : *list) {
         gl.DeleteVertexArrays(1, &m.vao);
         gl.DeleteBuffers(1, &m.vbo);
         gl.DeleteBuffers(1, &m.ebo);
       }
-    for (auto& m : materials) gl.DeleteTextures(1, &m.tex);
+    for (auto& m : materials) {
+      gl.DeleteTextures(1, &m.tex);
+      if (m.pieces) gl.DeleteTextures(1, &m.pieces);
+    }
     gl.DeleteTextures(1, &white);
     for (auto& row : colour)
       for (auto& p : row)
@@ -669,7 +680,7 @@ ColourProgram Renderer::Impl::make_colour_program(bool shadowed, bool stochastic
                            {&p.cloud_offset, "u_cloud_offset"}, {&p.cloud_period, "u_cloud_period"},
                            {&p.cloud_height, "u_cloud_height"}, {&p.cloud_block, "u_cloud_block"},
                            {&p.cell, "u_cell"}, {&p.aspect, "u_aspect"}, {&p.sharpness, "u_sharpness"},
-                           {&p.mean, "u_mean"}, {&p.seed, "u_seed"}})
+                           {&p.mean, "u_mean"}, {&p.pieces, "u_pieces"}})
     *loc = gl.GetUniformLocation(p.id, name);
   return p;
 }
@@ -720,6 +731,9 @@ Eigen::Matrix4f Renderer::Impl::render_shadow_map(const Eigen::Matrix4f& clip_fr
   if (lead_model)
     for (const auto& m : lead_meshes)
       for (const Chunk& c : m.chunks) add(c.box, *lead_model, true);
+  for (const Eigen::Matrix4d& M : body_models)  // casters: their shadows bound the map where they fall
+    for (const auto& m : body_meshes)
+      for (const Chunk& c : m.chunks) add(c.box, M, false);
   if (side.isEmpty()) side.extend(Eigen::Vector2d(0, 0)).extend(Eigen::Vector2d(1, 1));
   const double zlo = z0 - 1, zhi = z1 + 1;  // a metre of room at either end
   Eigen::Matrix4d L = Eigen::Matrix4d::Identity();
@@ -781,6 +795,8 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
     if (!m.indices.empty()) I.static_meshes.push_back(I.upload_mesh(m, kChunkSize));
   for (const auto& m : scene.lead_meshes)
     if (!m.indices.empty()) I.lead_meshes.push_back(I.upload_mesh(m, 0));
+  for (const auto& m : scene.body_meshes)
+    if (!m.indices.empty()) I.body_meshes.push_back(I.upload_mesh(m, 0));
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
     throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while uploading the scene");
 }
@@ -812,6 +828,19 @@ Eigen::Matrix4d Renderer::projection(double fx, double fy, double cx, double cy,
   return P;
 }
 
+namespace {
+
+// A model's frame in the world: at `pose`'s position, turned by its yaw about world z.
+Eigen::Matrix4d model_matrix(const LeadPose& pose) {
+  Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  M.topLeftCorner<3, 3>() << c, -s, 0, s, c, 0, 0, 0, 1;
+  M.topRightCorner<3, 1>() = pose.position;
+  return M;
+}
+
+}  // namespace
+
 Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w, int h,
                                const CameraView& view, const std::optional<LeadPose>& lead) {
   ctx_.make_current();
@@ -824,13 +853,10 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   V.topLeftCorner<3, 3>() = view.pose.R_CW;
   V.topRightCorner<3, 1>() = -view.pose.R_CW * view.pose.position;
   std::optional<Eigen::Matrix4d> lead_model;
-  if (lead && !I.lead_meshes.empty()) {
-    Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
-    const double c = std::cos(lead->yaw), s = std::sin(lead->yaw);
-    M.topLeftCorner<3, 3>() << c, -s, 0, s, c, 0, 0, 0, 1;
-    M.topRightCorner<3, 1>() = lead->position;
-    lead_model = M;
-  }
+  if (lead && !I.lead_meshes.empty()) lead_model = model_matrix(*lead);
+  I.body_models.clear();
+  if (!I.body_meshes.empty())
+    for (const LeadPose& b : view.bodies) I.body_models.push_back(model_matrix(b));
 
   if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   std::optional<Eigen::Matrix4f> light;

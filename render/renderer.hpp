@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "geometry/camera.hpp"
 #include "geometry/pose.hpp"
@@ -27,6 +28,9 @@ struct CameraView {
   geometry::PinholeCamera camera;
   geometry::CameraPose pose;
   double time = 0;  // s: what moves with time but is no pose (the clouds' shadows)
+  // Where the team's UAV bodies are (Scene::body_meshes; sim::uav_body_poses): drawn, and casting
+  // shadows, at these poses. Empty when the scene has no bodies.
+  std::vector<LeadPose> bodies{};
 };
 
 struct Frame {

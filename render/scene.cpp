@@ -317,21 +317,22 @@ constexpr double kCueLift = sim::kLeadCueLift;
 
 }  // namespace
 
-void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, const Material& sampling,
-                     Scene& scene) {
+std::vector<Mesh> load_model(const ModelPlacement& place, const std::string& path, const Material& sampling,
+                             Scene& scene) {
+  const std::string what = place.what + " '" + path + "'";
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw std::runtime_error("lead model '" + path + "': file not found");
+  if (!fs::is_regular_file(path, ec)) throw std::runtime_error(what + ": file not found");
   Assimp::Importer importer;
   const aiScene* ai = importer.ReadFile(
       path, aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices |
                 aiProcess_JoinIdenticalVertices);
   if (!ai || !ai->mRootNode || ai->mNumMeshes == 0)
-    throw std::runtime_error("lead model '" + path + "': not a 3D model assimp can read (" +
+    throw std::runtime_error(what + ": not a 3D model assimp can read (" +
                              (ai ? std::string("no meshes") : std::string(importer.GetErrorString())) +
                              ")");
   // Up axis to z: glTF's y-up becomes z-up by a +90 deg rotation about x.
   Eigen::Matrix3d U = Eigen::Matrix3d::Identity();
-  if (spec.up == "y") U << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+  if (place.up == "y") U << 1, 0, 0, 0, 0, -1, 0, 1, 0;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
   for (unsigned i = 0; i < ai->mNumMeshes; ++i)
     for (unsigned k = 0; k < ai->mMeshes[i]->mNumVertices; ++k) {
@@ -340,9 +341,9 @@ void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, co
       hi = hi.cwiseMax(p);
     }
   const double extent = hi.z() - lo.z();
-  if (!(extent > 0)) throw std::runtime_error("lead model '" + path + "': has no height");
-  const double s = spec.height / extent;
-  const Eigen::Vector3d top(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), hi.z());
+  if (!(extent > 0)) throw std::runtime_error(what + ": has no height");
+  const double s = place.height / extent;
+  const Eigen::Vector3d ref(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), place.on_top ? hi.z() : lo.z());
 
   // One material per assimp material that carries a texture.
   std::vector<int> mat_index(ai->mNumMaterials, -1);
@@ -367,28 +368,26 @@ void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, co
         raw = cv::imdecode(buf, cv::IMREAD_COLOR);
       }
       if (raw.empty())
-        throw std::runtime_error("lead model '" + path + "': cannot decode embedded texture '" +
-                                 tex.C_Str() + "'");
+        throw std::runtime_error(what + ": cannot decode embedded texture '" + tex.C_Str() + "'");
       cv::cvtColor(raw, mat.texture, cv::COLOR_BGR2RGB);
     } else {
       std::string name = tex.C_Str();
       std::replace(name.begin(), name.end(), '\\', '/');
       const fs::path tp = dir / name;
-      if (!fs::is_regular_file(tp, ec))
-        throw std::runtime_error("lead model '" + path + "': texture '" + tp.string() +
-                                 "' not found");
-      mat.texture = read_image_rgb(tp.string(), "lead model texture");
+      if (!fs::is_regular_file(tp, ec)) throw std::runtime_error(what + ": texture '" + tp.string() + "' not found");
+      mat.texture = read_image_rgb(tp.string(), (place.what + " texture").c_str());
     }
     mat_index[i] = static_cast<int>(scene.materials.size());
     scene.materials.push_back(std::move(mat));
   }
+  std::vector<Mesh> out;
   for (unsigned i = 0; i < ai->mNumMeshes; ++i) {
     const aiMesh* am = ai->mMeshes[i];
     Mesh m;
     m.material = mat_index[am->mMaterialIndex];
     const Eigen::Vector3d colour = mat_colour[am->mMaterialIndex];
     for (unsigned k = 0; k < am->mNumVertices; ++k) {
-      const Eigen::Vector3d p = s * (U * to_vec(am->mVertices[k]) - top) - Eigen::Vector3d(0, 0, kCueLift);
+      const Eigen::Vector3d p = s * (U * to_vec(am->mVertices[k]) - ref) + place.offset;
       const Eigen::Vector3d n = am->HasNormals() ? Eigen::Vector3d(U * to_vec(am->mNormals[k])) : Eigen::Vector3d(0, 0, 1);
       const Eigen::Vector2d uv = am->HasTextureCoords(0)
                                      ? Eigen::Vector2d(am->mTextureCoords[0][k].x, 1.0 - am->mTextureCoords[0][k].y)
@@ -399,8 +398,16 @@ void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, co
       if (am->mFaces[f].mNumIndices != 3) continue;
       for (int k = 0; k < 3; ++k) m.indices.push_back(am->mFaces[f].mIndices[k]);
     }
-    scene.lead_meshes.push_back(std::move(m));
+    out.push_back(std::move(m));
   }
+  return out;
+}
+
+void load_lead_model(const sim::LeadModelSpec& spec, const std::string& path, const Material& sampling,
+                     Scene& scene) {
+  // The reference point on the roof, the cue kCueLift above it.
+  const ModelPlacement place{"lead model", spec.up, spec.height, true, Eigen::Vector3d(0, 0, -kCueLift)};
+  for (Mesh& m : load_model(place, path, sampling, scene)) scene.lead_meshes.push_back(std::move(m));
 
   // The cue: a flat square centred on the reference point, kCueLift above the roof.
   if (spec.cue == sim::LeadModelSpec::Cue::None) return;
@@ -492,6 +499,11 @@ Scene build_scene(const sim::WorldDescription& world) {
         objects_mesh(objects, static_cast<int>(scene.materials.size()) - 1));
   }
   load_lead_model(w.lead, sim::resolve_asset(w.lead.model, world.scenario_path, "lead model"), ground, scene);
+  if (w.uav_bodies.enabled) {
+    const sim::UavBodiesSpec& b = w.uav_bodies;
+    const ModelPlacement place{"UAV body model", b.up, b.height, false, Eigen::Vector3d::Zero()};
+    scene.body_meshes = load_model(place, sim::resolve_asset(b.model, world.scenario_path, "UAV body model"), ground, scene);
+  }
   return scene;
 }
 

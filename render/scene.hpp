@@ -21,7 +21,8 @@ struct Material {
   double anisotropy = 4;
   bool trilinear = true;  // between mipmap levels; false: the nearest level only (faster)
   bool unlit = false;  // colour shown as is (markers, test targets)
-  // Stochastic tiling (world.texture.tiling, render/renderer.cpp kStochasticLookup): the triangle
+  // Stochastic tiling (world.texture.tiling, render/renderer.cpp kStochasticLookup, its pieces
+  // placed by render/piece_table.hpp from the seed): the triangle
   // grid's side as a fraction of the texture's shorter side; 0: the texture as it is.
   double stochastic_cell = 0;
   double blend_sharpness = 8;
@@ -48,6 +49,9 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Mesh> static_meshes;  // world frame
   std::vector<Mesh> lead_meshes;    // lead frame: origin at its reference point, x forward, z up
+  // One UAV's body (world.uav_bodies), drawn at each UAV's pose: origin at its bottom centre, x
+  // forward, z up. Empty when the team's bodies are off.
+  std::vector<Mesh> body_meshes;
   sim::LightSpec light{};
   Eigen::Vector3d sky{0.62, 0.74, 0.88};
   double near = 0.1, far = 1000;
@@ -57,6 +61,22 @@ struct Scene {
 
 // Pose of the lead's reference point: position in the world and heading about world z.
 using LeadPose = sim::LeadPose;
+
+// Where a model from a file goes: scaled to `height`, its up axis made z, the centre of its
+// bounding box's top face (on_top) or bottom face at `offset`. `what` names it in errors.
+struct ModelPlacement {
+  std::string what;
+  std::string up = "z";
+  double height = 1;
+  bool on_top = true;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+};
+
+// A model from any format assimp reads, placed as `place` says; its textured materials join
+// scene.materials (sampled as the lead model's are). Throws std::runtime_error naming the file
+// when it is missing, not a model, or refers to a missing texture.
+std::vector<Mesh> load_model(const ModelPlacement& place, const std::string& path, const Material& sampling,
+                             Scene& scene);
 
 // The lead model from any format assimp reads, scaled to `height`, its up axis made z, its
 // top-centre moved to the origin; with the cue on its roof. Throws std::runtime_error naming the

@@ -169,6 +169,15 @@ LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world) {
   return p;
 }
 
+std::vector<LeadPose> uav_body_poses(const Truth& truth, double t, const WorldSpec& world) {
+  std::vector<LeadPose> out;
+  if (!world.uav_bodies.enabled) return out;
+  // The model's bottom centre `above` over the camera, which hangs under the body.
+  for (int j = 0; j < static_cast<int>(truth.scenario().uavs.size()); ++j)
+    out.push_back({truth.camera(j, t).position + Eigen::Vector3d(0, 0, world.uav_bodies.above), truth.uav_yaw(j, t)});
+  return out;
+}
+
 }  // namespace wingman::sim
 
 namespace wingman::sim {

@@ -52,14 +52,15 @@ struct TextureSpec {
   // m: the world point of one copy's top-left corner (tiled), so that a flight can lie inside one
   // copy of a large image and see no repetition.
   double origin_x = 0, origin_y = 0;
-  // How a tiled texture fills a world larger than one copy (docs/rendering.md, The world): repeat
-  // tiles the image as it is; stochastic lays a triangle grid over the ground and shows at each of
-  // its vertices a piece of the image from a place drawn for that vertex, blended across the cells
-  // with the image's variance kept (Heitz & Neyret 2018), so that no copy, lattice or seam of the
-  // image repeats (but its content recurs at random offsets: docs/studies/ground-tiling.md).
+  // How a tiled texture fills a world larger than one copy (docs/rendering.md, The world):
+  // stochastic (the default) lays a triangle grid over the ground and shows at each of its vertices
+  // a piece of the image, blended across the cells with the image's variance kept (Heitz & Neyret
+  // 2018), the pieces placed so that nearby vertices never show the same ground a short way apart
+  // (render/piece_table.hpp), so that no copy, lattice or seam of the image repeats; repeat tiles
+  // the image as it is (for a flight that stays inside one copy of a large image).
   // `cell`: the grid's side as a fraction of the image's shorter side; `blend_sharpness`: the
   // power of the blend weights (1: linear blend; higher: narrower transitions).
-  Tiling tiling = Tiling::Repeat;
+  Tiling tiling = Tiling::Stochastic;
   double cell = 0.25;
   double blend_sharpness = 8;
   double detail_min = 0.02;  // m, finest and coarsest detail of the procedural texture
@@ -246,11 +247,32 @@ struct ImageEffectsSpec {
   }
 };
 
+// The team's own bodies (render/scene.hpp body_meshes): each UAV's model at its true position and
+// yaw, seen by the other UAVs' cameras and casting its shadow (its own camera's included) when
+// world.light.shadows is on. Off by default: the paper's cameras see no other UAV.
+struct UavBodiesSpec {
+  bool enabled = false;
+  std::string model = "models/quadrotor/quadrotor.obj";  // scenario dir, then assets/
+  double height = 0.28;   // m, the model is scaled to this height
+  std::string up = "z";   // the model's up axis: y (glTF) or z
+  double above = 0.05;    // m from the camera (the UAV's position) up to the model's bottom
+
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled);
+    v("model", model);
+    v("height", height, geometry::in(0.01, 10));
+    v.choice("up", up, {{"y", std::string("y")}, {"z", std::string("z")}});
+    v("above", above, geometry::in(0, 10));
+  }
+};
+
 struct WorldSpec {
   TerrainSpec terrain{};
   TextureSpec texture{};
   ObjectsSpec objects{};
   LeadModelSpec lead{};
+  UavBodiesSpec uav_bodies{};
   LightSpec light{};
   ImageEffectsSpec image{};
   double near = 0.1, far = 1000;  // m, clip planes
@@ -267,6 +289,7 @@ struct WorldSpec {
     v.section("texture", [&](auto& x) { texture.visit(x); });
     v.section("objects", [&](auto& x) { objects.visit(x); });
     v.section("lead", [&](auto& x) { lead.visit(x); });
+    v.section("uav_bodies", [&](auto& x) { uav_bodies.visit(x); });
     v.section("light", [&](auto& x) { light.visit(x); });
     v.section("image", [&](auto& x) { image.visit(x); });
     v("near", near, geometry::gt(0));
@@ -336,6 +359,8 @@ struct LeadPose {
   double yaw = 0;
 };
 LeadPose lead_pose(const Truth& truth, double t, const WorldSpec& world);
+// Where each UAV's body is at t (world.uav_bodies): its true position and yaw; none when off.
+std::vector<LeadPose> uav_body_poses(const Truth& truth, double t, const WorldSpec& world);
 // The lead's heading about world z at t: its direction of travel (that of t + 0.1 s at a standstill).
 double lead_heading(const Truth& truth, double t);
 

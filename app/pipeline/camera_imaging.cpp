@@ -69,8 +69,8 @@ TakenFrame CameraImaging::take(const sim::Truth& truth, double t, const Draw& dr
   const sim::KinematicState k = truth.camera(uav_, t);
   TakenFrame out;
   out.frame = render::expose(shutter, exposure(), model_.width(), model_.height(), [&](double dt, int row0, int rows) {
-    return draw({model_, pose_after(truth, uav_, t, k, dt), t + dt}, sim::lead_pose(truth, t + dt, scn_.world), row0,
-                rows);
+    return draw({model_, pose_after(truth, uav_, t, k, dt), t + dt, sim::uav_body_poses(truth, t + dt, scn_.world)},
+                sim::lead_pose(truth, t + dt, scn_.world), row0, rows);
   });
   out.poses = true_poses(scn_, truth, uav_, t);
   if (haze_) haze_->apply(out.frame);

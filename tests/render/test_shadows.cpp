@@ -1,6 +1,6 @@
 // Shadows from the sun, with both backends: a box's shadow falls on the ground where geometry
 // puts it (its outline cast along the light), holds the ambient light only, and the lit ground
-// keeps the brightness it has without shadows.
+// keeps the brightness it has without shadows; a UAV body is seen and casts its shadow.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -82,6 +82,44 @@ TEST_P(ShadowTest, ABoxsShadowFallsWhereTheLightCastsItsOutline) {
 // Clouds 100 m up whose texture is cloud on its left half over a 40 m period: under a light
 // travelling (0.3, 0, -1) a ground point x looks toward the sun through the layer at x - 30 m, so
 // cloud shades x in [-10, 10) (mod 40) at t = 0, and the wind carries that band 3 m east a second.
+// A UAV body (Scene::body_meshes, a 1 m cube here) at each of CameraView::bodies: seen where it
+// is, 10 m under a camera 20 m up, and its shadow cast along the light onto the ground, 10 m east
+// of it under a sun 45 deg up from the west; with no bodies in the view neither shows.
+TEST_P(ShadowTest, AUavBodyIsSeenAndCastsItsShadowWhereTheLightPutsIt) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  Scene s;
+  s.materials.push_back(Material{});
+  s.static_meshes.push_back(testing::square({0, 0, 0}, 80, {1, 1, 1}, 0));
+  s.body_meshes.push_back(box(-0.5, 0.5, -0.5, 0.5, 1));
+  s.body_meshes.back().material = 0;
+  s.light.direction = {1, 0, -1};
+  s.light.shadows = true;
+  s.msaa = 1;
+  Renderer r(ctx, s);
+  const geometry::PinholeCamera cam(250, 250, 199.5, 199.5, 400, 400);  // 8 cm a pixel on the ground
+  CameraView view{cam, {geometry::nadir_R_CW(), {5, 0, 20}}};
+  const Frame empty = r.render(view);
+  view.bodies = {{{0, 0, 9.5}, 0.3}};  // bottom at 9.5 m, top at 10.5 m
+  const Frame f = r.render(view);
+  auto px = [&](const Eigen::Vector3d& p) {
+    const auto uv = cam.project(view.pose.to_camera(p));
+    return cv::Point(static_cast<int>(std::lround(uv->x())), static_cast<int>(std::lround(uv->y())));
+  };
+  auto grey = [](const Frame& fr, cv::Point q) {
+    const cv::Vec3b c = fr.rgb.at<cv::Vec3b>(q);
+    return (c[0] + c[1] + c[2]) / 3.0;
+  };
+  // The body: its top 9.5 m from the camera along the optical axis; nothing there without it.
+  EXPECT_NEAR(f.depth.at<float>(px({0, 0, 10.5})), 9.5, 0.05);
+  EXPECT_NEAR(empty.depth.at<float>(px({0, 0, 10.5})), 20, 0.05);
+  // Its shadow: the cube's centre (0, 0, 10) cast along (1, 0, -1) meets the ground at (10, 0).
+  const double ambient = 255 * 0.45, sunlit = 255 * (0.45 + 0.65 * std::sqrt(0.5));
+  EXPECT_NEAR(grey(f, px({10, 0, 0})), ambient, 2);
+  EXPECT_NEAR(grey(empty, px({10, 0, 0})), sunlit, 2);
+  for (const auto& q : {Eigen::Vector3d(10, 1.2, 0), Eigen::Vector3d(11.8, 0, 0), Eigen::Vector3d(8.2, 0, 0)})
+    EXPECT_NEAR(grey(f, px(q)), sunlit, 2) << q.transpose();
+}
+
 TEST_P(ShadowTest, CloudShadowsFallWhereTheSunLooksThroughTheLayerAndDriftWithTheWind) {
   WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
   Scene s;

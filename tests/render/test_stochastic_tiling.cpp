@@ -1,7 +1,8 @@
 // Stochastic tiling of a ground texture, with both backends: a nadir frame over several copies of
 // the image shows no copy again one period away (where repeat tiling shows the very same pixels),
 // keeps the image's mean and contrast, and never wraps a piece over the image's border (where
-// repeat tiling draws the seam of a photo that is not periodic).
+// repeat tiling draws the seam of a photo that is not periodic), and shows at each grid vertex the
+// piece its table places there.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -9,6 +10,7 @@
 #include <random>
 
 #include "geometry/rotation.hpp"
+#include "render/piece_table.hpp"
 #include "render/renderer.hpp"
 #include "render_test_support.hpp"
 
@@ -96,6 +98,50 @@ TEST_P(StochasticTilingTest, NoCopyOfTheImageRecursOnePeriodAway) {
     worst = std::max(worst, ncc(stochastic(a), stochastic(b)));
   }
   EXPECT_LT(worst, 0.5);
+}
+
+// A texture whose red and green levels are its own column and row (scaled to 0-255): each pixel of
+// a frame says which texel of the image it shows.
+cv::Mat coordinate_texture() {
+  cv::Mat rgb(192, 256, CV_8UC3);
+  for (int r = 0; r < rgb.rows; ++r)
+    for (int c = 0; c < rgb.cols; ++c)
+      rgb.at<cv::Vec3b>(r, c) = {static_cast<std::uint8_t>(c), static_cast<std::uint8_t>(std::lround(r * 255.0 / 191)), 128};
+  return rgb;
+}
+
+// Where the pieces lie is the piece table's (render/piece_table.hpp, whose tests check that nearby
+// vertices never show copies of the same ground a short way apart): at every grid vertex in view,
+// where that vertex's piece has all the weight, the frame shows the image at the table's centre.
+TEST_P(StochasticTilingTest, EachGridVertexShowsTheImageAtItsTablesCentre) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  const geometry::PinholeCamera cam(400, 400, 199.5, 199.5, 400, 400);
+  const Eigen::Vector3d C(3, -2, 40);
+  Renderer r(ctx, ground_scene(coordinate_texture(), true));
+  const cv::Mat frame = r.render({cam, {geometry::nadir_R_CW(), C}}).rgb;
+  const double aspect = 0.75, cell = 0.25 * aspect;  // in units of the image's width (20 m)
+  const PieceTable table = piece_table(cell, aspect, 0);
+  int checked = 0;
+  double worst = 0;
+  for (int j = -20; j <= 20; ++j)
+    for (int i = -20; i <= 20; ++i) {
+      // The vertex in texture space (u across, v * aspect down), then on the ground: u = x / 20,
+      // v = -y / 15.
+      const double qx = cell * (i + 0.5 * j), qy = cell * 0.8660254037844386 * j;
+      const Eigen::Vector3d p(kTileW * qx, -kTileH * qy / aspect, 0);
+      const auto px = cam.project(geometry::nadir_R_CW() * (p - C));
+      if (!px || px->x() < 2 || px->y() < 2 || px->x() > 397 || px->y() > 397) continue;
+      const cv::Vec3b got = frame.at<cv::Vec3b>(static_cast<int>(std::lround(px->y())), static_cast<int>(std::lround(px->x())));
+      double u, v;
+      table.centre(i, j, u, v);
+      // Texel centres carry their index: u = (level + 0.5) / 256 across, v / aspect likewise down.
+      const double want_r = u * 256 - 0.5, want_g = (v / aspect * 192 - 0.5) * 255 / 191;
+      worst = std::max({worst, std::abs(got[0] - want_r), std::abs(got[1] - want_g)});
+      ++checked;
+    }
+  EXPECT_GT(checked, 100);
+  // Half a pixel from the vertex moves the reading by 0.7 levels; filtering and rounding add one.
+  EXPECT_LT(worst, 2.0) << checked << " vertices";
 }
 
 TEST_P(StochasticTilingTest, TheImagesMeanAndContrastAreKept) {

@@ -1,13 +1,17 @@
 // A camera with every shutter and sensor effect through `wingman render` and `wingman run`: the
 // dataset records the shutter, each row's time and every frame's exposure and gain; auto-exposure
 // moves the exposure over a flight; a bad shutter or sensor key exits 2 naming file, line and key,
-// with nothing written.
+// with nothing written; the team's bodies appear in each other's frames.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "app/app_test_support.hpp"
+#include "geometry/camera.hpp"
+#include "geometry/rotation.hpp"
 
 namespace wingman::app::test {
 namespace {
@@ -80,6 +84,46 @@ TEST(CameraEffectsCli, AnImpossibleShutterOrSensorExitsTwoNamingFileLineAndKey) 
     EXPECT_THAT(r.output, ::testing::HasSubstr(c.message)) << c.extra;
     EXPECT_FALSE(fs::exists(tmp / "ds"));
   }
+}
+
+// world.uav_bodies: uav2's camera, 2 m above uav1 and 3 m east of it, sees uav1's body where its
+// true pose projects (the only pixels that differ from the frame without bodies), while uav1's own
+// body, above its camera, never enters its own frame; a missing body model exits 2 naming the key.
+TEST(CameraEffectsCli, TheTeamsBodiesAreSeenWhereTheyAre) {
+  TempDir tmp;
+  const std::string flight = scenario("");
+  write_file(tmp / "plain.yaml", flight);
+  write_file(tmp / "bodies.yaml", flight + "world: {uav_bodies: {enabled: true}}\n");
+  for (const char* name : {"plain", "bodies"}) {
+    const auto r = run_wingman({"render", (tmp / (std::string(name) + ".yaml")).string(), "--frames", "1", "--out",
+                                (tmp / name).string(), "--gl", "osmesa", "-q"},
+                               tmp.path());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  auto frame = [&](const char* run, const char* uav) {
+    return cv::imread((tmp / run / uav / "mav0" / "cam0" / "data" / "0.png").string(), cv::IMREAD_GRAYSCALE);
+  };
+  EXPECT_EQ(cv::countNonZero(frame("plain", "uav1") != frame("bodies", "uav1")), 0);
+  const cv::Mat differ = frame("plain", "uav2") != frame("bodies", "uav2");
+  ASSERT_GT(cv::countNonZero(differ), 30);
+  // uav1's body, 0.05 to 0.33 m above its camera, seen from uav2's nadir camera (f = 40 px): the
+  // pixels that change lie between where its top and its bottom centres project.
+  const geometry::PinholeCamera cam(40.02, 40.02, 99.5, 99.5, 200, 200);
+  const Eigen::Vector3d camera(1.5, 0, 17);
+  const auto top = cam.project(geometry::nadir_R_CW() * (Eigen::Vector3d(-1.5, 0, 15.33) - camera));
+  const auto bottom = cam.project(geometry::nadir_R_CW() * (Eigen::Vector3d(-1.5, 0, 15.05) - camera));
+  ASSERT_TRUE(top && bottom);
+  const cv::Moments m = cv::moments(differ, true);
+  EXPECT_GT(m.m10 / m.m00, std::min(top->x(), bottom->x()) - 1);
+  EXPECT_LT(m.m10 / m.m00, std::max(top->x(), bottom->x()) + 1);
+  EXPECT_NEAR(m.m01 / m.m00, top->y(), 2);
+
+  write_file(tmp / "nomodel.yaml", flight + "world: {uav_bodies: {enabled: true, model: nowhere.obj}}\n");
+  const auto r = run_wingman({"render", (tmp / "nomodel.yaml").string(), "--out", (tmp / "ds").string(), "-q"},
+                             tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, ::testing::HasSubstr("nowhere.obj"));
+  EXPECT_FALSE(fs::exists(tmp / "ds"));
 }
 
 }  // namespace
