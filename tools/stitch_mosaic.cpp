@@ -3,9 +3,11 @@
 // registering them, composing them at the mosaic's ground sampling distance and blending the seams
 // with multi-band blending, and the largest rectangle the photos cover fully cut out, so
 // the mosaic has no empty corner.
-//   stitch_mosaic OUT.(jpg|png) GSD_IN M_PER_PX PHOTO [PHOTO ...]
-// GSD_IN: metres per pixel of the photos; M_PER_PX: of the mosaic. Prints the mosaic's size in
-// pixels and metres. Exit 2 on bad arguments or an unreadable photo, 1 when the photos do not join.
+//   stitch_mosaic [--crop X,Y,W,H] OUT.(jpg|png) GSD_IN M_PER_PX PHOTO [PHOTO ...]
+// GSD_IN: metres per pixel of the photos; M_PER_PX: of the mosaic. --crop keeps that rectangle
+// (mosaic pixels, from the covered rectangle's top-left) of the result, to leave out a part the
+// registration smeared. Prints the mosaic's size in pixels and metres. Exit 2 on bad arguments or
+// an unreadable photo, 1 when the photos do not join.
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/stitching.hpp>
@@ -42,8 +44,18 @@ cv::Rect largest_filled_rect(const cv::Mat& mask) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  cv::Rect crop;
+  if (argc > 2 && std::string(argv[1]) == "--crop") {
+    if (std::sscanf(argv[2], "%d,%d,%d,%d", &crop.x, &crop.y, &crop.width, &crop.height) != 4 || crop.x < 0 ||
+        crop.y < 0 || crop.width <= 0 || crop.height <= 0) {
+      std::fprintf(stderr, "stitch_mosaic: --crop %s: want X,Y,W,H in pixels, W and H above 0\n", argv[2]);
+      return 2;
+    }
+    argv += 2;
+    argc -= 2;
+  }
   if (argc < 5) {
-    std::fprintf(stderr, "usage: %s OUT.(jpg|png) GSD_IN M_PER_PX PHOTO [PHOTO ...]\n", argv[0]);
+    std::fprintf(stderr, "usage: stitch_mosaic [--crop X,Y,W,H] OUT.(jpg|png) GSD_IN M_PER_PX PHOTO [PHOTO ...]\n");
     return 2;
   }
   const double gsd = std::atof(argv[2]), out_gsd = std::atof(argv[3]);
@@ -86,7 +98,15 @@ int main(int argc, char** argv) {
   cv::cvtColor(pano, grey, cv::COLOR_BGR2GRAY);
   cv::threshold(grey, mask, 0, 255, cv::THRESH_BINARY);
   cv::erode(mask, mask, cv::Mat(), cv::Point(-1, -1), 2);  // off the blended border
-  const cv::Rect keep = largest_filled_rect(mask);
+  cv::Rect keep = largest_filled_rect(mask);
+  if (crop.area() > 0) {
+    if ((crop & cv::Rect(0, 0, keep.width, keep.height)) != crop) {
+      std::fprintf(stderr, "stitch_mosaic: --crop %d,%d,%d,%d lies outside the %d x %d px mosaic\n", crop.x, crop.y,
+                   crop.width, crop.height, keep.width, keep.height);
+      return 2;
+    }
+    keep = cv::Rect(keep.x + crop.x, keep.y + crop.y, crop.width, crop.height);
+  }
   if (keep.area() == 0) {
     std::fprintf(stderr, "stitch_mosaic: the mosaic covers no rectangle\n");
     return 1;

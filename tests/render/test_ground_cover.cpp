@@ -13,8 +13,10 @@
 namespace wingman::sim {
 namespace {
 
-TEST(GroundCover, EveryViewOfTheParkSceneLiesInsideOneCopyOfItsMosaic) {
-  const Scenario scn = load_scenarios(WINGMAN_SOURCE_DIR "/scenes/person_park_rendered.yaml").front();
+class GroundCover : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(GroundCover, EveryViewLiesInsideOneCopyOfTheMosaic) {
+  const Scenario scn = load_scenarios(std::string(WINGMAN_SOURCE_DIR "/scenes/") + GetParam()).front();
   const TextureSpec& tex = scn.world.texture;
   const cv::Mat img = cv::imread(resolve_asset(tex.image, scn.source_path, "ground texture"));
   ASSERT_FALSE(img.empty());
@@ -41,6 +43,13 @@ TEST(GroundCover, EveryViewOfTheParkSceneLiesInsideOneCopyOfItsMosaic) {
   }
   EXPECT_GT(margin, 0) << "a view reaches " << -margin << " m past the mosaic's edge";
 }
+
+// The park (Brighton Beach) and the construction site (Caliterra).
+INSTANTIATE_TEST_SUITE_P(MosaicScenes, GroundCover,
+                         ::testing::Values("person_park_rendered.yaml", "person_site_rendered.yaml"),
+                         [](const ::testing::TestParamInfo<const char*>& i) {
+                           return i.index == 0 ? std::string("Park") : std::string("ConstructionSite");
+                         });
 
 }  // namespace
 }  // namespace wingman::sim
