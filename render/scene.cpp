@@ -315,6 +315,47 @@ constexpr double kSolidAnisotropy = 1.0;
 
 constexpr double kCueLift = sim::kLeadCueLift;
 
+// A model's materials: its colours, and for each one that carries a texture a Material appended to
+// scene.materials (its index, -1 for none). `what` names the model in errors.
+std::vector<int> load_materials(const aiScene* ai, const fs::path& dir, const std::string& kind, const std::string& what,
+                                const Material& sampling, std::vector<Eigen::Vector3d>& mat_colour, Scene& scene) {
+  std::vector<int> mat_index(ai->mNumMaterials, -1);
+  mat_colour.assign(ai->mNumMaterials, Eigen::Vector3d::Ones());
+  std::error_code ec;
+  for (unsigned i = 0; i < ai->mNumMaterials; ++i) {
+    const aiMaterial* m = ai->mMaterials[i];
+    aiColor4D c;
+    if (m->Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS || m->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
+      mat_colour[i] = {c.r, c.g, c.b};
+    aiString tex;
+    if (m->GetTexture(aiTextureType_DIFFUSE, 0, &tex) != AI_SUCCESS &&
+        m->GetTexture(aiTextureType_BASE_COLOR, 0, &tex) != AI_SUCCESS)
+      continue;
+    Material mat;
+    mat.anisotropy = kSolidAnisotropy;
+    mat.trilinear = sampling.trilinear;
+    if (const aiTexture* emb = ai->GetEmbeddedTexture(tex.C_Str())) {
+      cv::Mat raw;
+      if (emb->mHeight == 0) {
+        cv::Mat buf(1, static_cast<int>(emb->mWidth), CV_8U, emb->pcData);
+        raw = cv::imdecode(buf, cv::IMREAD_COLOR);
+      }
+      if (raw.empty())
+        throw std::runtime_error(what + ": cannot decode embedded texture '" + tex.C_Str() + "'");
+      cv::cvtColor(raw, mat.texture, cv::COLOR_BGR2RGB);
+    } else {
+      std::string name = tex.C_Str();
+      std::replace(name.begin(), name.end(), '\\', '/');
+      const fs::path tp = dir / name;
+      if (!fs::is_regular_file(tp, ec)) throw std::runtime_error(what + ": texture '" + tp.string() + "' not found");
+      mat.texture = read_image_rgb(tp.string(), (kind + " texture").c_str());
+    }
+    mat_index[i] = static_cast<int>(scene.materials.size());
+    scene.materials.push_back(std::move(mat));
+  }
+  return mat_index;
+}
+
 }  // namespace
 
 std::vector<Mesh> load_model(const ModelPlacement& place, const std::string& path, const Material& sampling,
@@ -345,41 +386,9 @@ std::vector<Mesh> load_model(const ModelPlacement& place, const std::string& pat
   const double s = place.height / extent;
   const Eigen::Vector3d ref(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), place.on_top ? hi.z() : lo.z());
 
-  // One material per assimp material that carries a texture.
-  std::vector<int> mat_index(ai->mNumMaterials, -1);
-  std::vector<Eigen::Vector3d> mat_colour(ai->mNumMaterials, Eigen::Vector3d::Ones());
-  const fs::path dir = fs::path(path).parent_path();
-  for (unsigned i = 0; i < ai->mNumMaterials; ++i) {
-    const aiMaterial* m = ai->mMaterials[i];
-    aiColor4D c;
-    if (m->Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS || m->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
-      mat_colour[i] = {c.r, c.g, c.b};
-    aiString tex;
-    if (m->GetTexture(aiTextureType_DIFFUSE, 0, &tex) != AI_SUCCESS &&
-        m->GetTexture(aiTextureType_BASE_COLOR, 0, &tex) != AI_SUCCESS)
-      continue;
-    Material mat;
-    mat.anisotropy = kSolidAnisotropy;
-    mat.trilinear = sampling.trilinear;
-    if (const aiTexture* emb = ai->GetEmbeddedTexture(tex.C_Str())) {
-      cv::Mat raw;
-      if (emb->mHeight == 0) {
-        cv::Mat buf(1, static_cast<int>(emb->mWidth), CV_8U, emb->pcData);
-        raw = cv::imdecode(buf, cv::IMREAD_COLOR);
-      }
-      if (raw.empty())
-        throw std::runtime_error(what + ": cannot decode embedded texture '" + tex.C_Str() + "'");
-      cv::cvtColor(raw, mat.texture, cv::COLOR_BGR2RGB);
-    } else {
-      std::string name = tex.C_Str();
-      std::replace(name.begin(), name.end(), '\\', '/');
-      const fs::path tp = dir / name;
-      if (!fs::is_regular_file(tp, ec)) throw std::runtime_error(what + ": texture '" + tp.string() + "' not found");
-      mat.texture = read_image_rgb(tp.string(), (place.what + " texture").c_str());
-    }
-    mat_index[i] = static_cast<int>(scene.materials.size());
-    scene.materials.push_back(std::move(mat));
-  }
+  std::vector<Eigen::Vector3d> mat_colour;
+  const std::vector<int> mat_index = load_materials(ai, fs::path(path).parent_path(), place.what, what, sampling,
+                                                    mat_colour, scene);
   std::vector<Mesh> out;
   for (unsigned i = 0; i < ai->mNumMeshes; ++i) {
     const aiMesh* am = ai->mMeshes[i];
