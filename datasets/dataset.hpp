@@ -28,6 +28,7 @@
 
 #include "datasets/layout.hpp"
 #include "geometry/camera.hpp"
+#include "geometry/lead_image.hpp"
 
 namespace wingman::datasets {
 
@@ -74,6 +75,14 @@ struct ExposureSample {
   std::int64_t t_ns = 0;
   double exposure_s = 0;
   double gain = 1;
+};
+
+// cam0_lead0/data.csv: where the lead is in a camera's frame, ground truth for lead detectors.
+inline constexpr const char* kLeadLabelHeader =
+    "#timestamp [ns],u [px],v [px],distance [m],visible [],box_u0 [px],box_v0 [px],box_u1 [px],box_v1 [px]";
+struct LeadLabel {
+  std::int64_t t_ns = 0;
+  geometry::LeadImage lead;
 };
 
 // A body pose (state_groundtruth_estimate0: p_WB, q = R_WB, velocity in the world frame and the
@@ -127,6 +136,7 @@ struct AgentData {
   std::vector<Vec3Sample> gps;
   std::vector<ScalarSample> altimeter, range, ahrs;
   std::vector<ExposureSample> exposure;  // cameras with an exposure time
+  std::vector<LeadLabel> lead_labels;    // cameras of a scene with a lead model: one per frame
 };
 
 struct Dataset {
@@ -174,6 +184,7 @@ class DatasetWriter {
   void ground_truth(const std::string& agent, const PoseSample& s);
   void camera_pose(const std::string& agent, const PoseSample& s);
   void exposure(const std::string& agent, const ExposureSample& s);
+  void lead_label(const std::string& agent, const LeadLabel& s);
   void gps(const std::string& agent, const Vec3Sample& s);
   void altimeter(const std::string& agent, const ScalarSample& s);
   void range(const std::string& agent, const ScalarSample& s);

@@ -357,6 +357,38 @@ std::vector<ScalarSample> read_scalars(const fs::path& csv) {
   return out;
 }
 
+// cam0_lead0/data.csv: one row per frame, at the frames' stamps; u, v may be nan (behind).
+std::vector<LeadLabel> read_lead_labels(const fs::path& csv, const std::vector<std::int64_t>& frames) {
+  std::vector<LeadLabel> out;
+  const auto rows = read_csv(csv, 9);
+  if (rows.size() != frames.size()) fail(csv, fmt::format("has {} rows for {} frames", rows.size(), frames.size()));
+  auto pixel = [&](const std::string& x, std::size_t i) {
+    return x == "nan" ? std::numeric_limits<double>::quiet_NaN() : num(x, csv, i);
+  };
+  auto column = [&](const std::string& x, std::size_t i) {
+    const double v = num(x, csv, i);
+    if (v != std::floor(v)) fail(csv, fmt::format("data row {}: box bound {} is not a whole pixel", i + 1, x));
+    return static_cast<int>(v);
+  };
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    LeadLabel label;
+    label.t_ns = stamp(r[0], csv, i);
+    geometry::LeadImage& l = label.lead;
+    if (label.t_ns != frames[i]) fail(csv, fmt::format("data row {}: time stamp {} is not frame {}'s", i + 1, r[0], i + 1));
+    l.uv = {pixel(r[1], i), pixel(r[2], i)};
+    l.distance = num(r[3], csv, i);
+    l.visible = num(r[4], csv, i);
+    if (l.distance < 0 || l.visible < 0 || l.visible > 1)
+      fail(csv, fmt::format("data row {}: distance must be >= 0 and visible in [0, 1]", i + 1));
+    l.box_u0 = column(r[5], i), l.box_v0 = column(r[6], i), l.box_u1 = column(r[7], i), l.box_v1 = column(r[8], i);
+    if (l.box_u1 < l.box_u0 || l.box_v1 < l.box_v0)
+      fail(csv, fmt::format("data row {}: the box's far bounds lie before its near ones", i + 1));
+    out.push_back(label);
+  }
+  return out;
+}
+
 // Agent names are folder names: plain, so that none reaches outside the dataset, and unique.
 void check_agent_names(const std::vector<std::string>& names, const fs::path& yf) {
   if (names.empty()) fail(yf, "agents: the list is empty");
@@ -462,6 +494,9 @@ void read_camera_sensors(const Dataset& ds, AgentData& a) {
   a.camera_pose = read_poses(poses, PoseFile::Camera, v);
   if (a.camera_pose.size() != a.frames.size())
     fail(poses, fmt::format("has {} poses for {} frames", a.camera_pose.size(), a.frames.size()));
+  std::error_code ec;
+  if (const fs::path labels = l.sensor(ds.root, a.name, "cam0_lead0"); fs::exists(labels, ec))
+    a.lead_labels = read_lead_labels(labels / "data.csv", a.frames);
   if (v >= 2) {
     const fs::path imu0 = required(l.sensor(ds.root, a.name, "imu0"), "every UAV carries an IMU");
     a.imu_info = read_imu_info(imu0 / "sensor.yaml");

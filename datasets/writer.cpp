@@ -198,6 +198,7 @@ void DatasetWriter::write_frame(const std::string& agent, std::int64_t t_ns, con
 
 void DatasetWriter::ground_truth(const std::string& agent, const PoseSample& s) { get(agent).groundtruth.push_back(s); }
 void DatasetWriter::camera_pose(const std::string& agent, const PoseSample& s) { get(agent).camera_pose.push_back(s); }
+void DatasetWriter::lead_label(const std::string& agent, const LeadLabel& s) { get(agent).lead_labels.push_back(s); }
 void DatasetWriter::gps(const std::string& agent, const Vec3Sample& s) { get(agent).gps.push_back(s); }
 void DatasetWriter::altimeter(const std::string& agent, const ScalarSample& s) { get(agent).altimeter.push_back(s); }
 void DatasetWriter::range(const std::string& agent, const ScalarSample& s) { get(agent).range.push_back(s); }
@@ -376,6 +377,15 @@ void write_frames(const fs::path& mav0, const AgentData& a) {
                 return fmt::format("{},{},{}", x.t_ns, g(x.exposure_s), g(x.gain));
               });
   write_camera_yaml(mav0 / "depth0" / "sensor.yaml", *a.camera, true);
+  if (a.lead_labels.empty()) return;
+  write_csv(mav0 / "cam0_lead0" / "data.csv", kLeadLabelHeader, a.lead_labels.size(), [&](std::size_t i) {
+    const auto& x = a.lead_labels[i].lead;
+    return fmt::format("{},{},{},{},{},{},{},{},{}", a.lead_labels[i].t_ns, g(x.uv.x()), g(x.uv.y()), g(x.distance),
+                       g(x.visible), x.box_u0, x.box_v0, x.box_u1, x.box_v1);
+  });
+  write_plain_yaml(mav0 / "cam0_lead0" / "sensor.yaml", "lead_label",
+                   "the lead in cam0's frames: x_h's projection (its row's pose), its distance, the visible share "
+                   "of its silhouette and the visible pixels' box");
 }
 
 // One agent's folder (<agent>/mav0), everything but the images.

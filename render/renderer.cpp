@@ -900,6 +900,86 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   return f;
 }
 
+namespace {
+
+// The lead model's box projected into the pinhole image (padded by a pixel), or, when part of it
+// is behind the camera, the image with a margin; nothing when all of it is.
+std::optional<cv::Rect> silhouette_window(const Eigen::AlignedBox3f& box, const Eigen::Matrix4d& M,
+                                          const CameraView& view, double near, int max_side) {
+  const auto& cam = view.camera;
+  const int margin = max_side / 4;
+  const cv::Rect around(-margin, -margin, cam.width() + 2 * margin, cam.height() + 2 * margin);
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  int in_front = 0;
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d p_W = (M * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(i))
+                                         .cast<double>()
+                                         .homogeneous())
+                                    .head<3>();
+    const Eigen::Vector3d p = view.pose.R_CW * (p_W - view.pose.position);
+    if (p.z() <= near) continue;
+    ++in_front;
+    const double u = cam.fx() * p.x() / p.z() + cam.cx(), v = cam.fy() * p.y() / p.z() + cam.cy();
+    u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+  }
+  if (in_front == 0) return std::nullopt;
+  if (in_front < 8) return around;
+  // Clamped before the cast: a corner just past the near plane projects far out.
+  auto clamp = [&](double x) { return std::clamp(x, -1e7, 1e7); };
+  const int x0 = static_cast<int>(std::floor(clamp(u0))) - 1, y0 = static_cast<int>(std::floor(clamp(v0))) - 1;
+  cv::Rect w(x0, y0, static_cast<int>(std::ceil(clamp(u1))) + 2 - x0, static_cast<int>(std::ceil(clamp(v1))) + 2 - y0);
+  if (w.width > max_side || w.height > max_side) w &= around;
+  if (w.empty()) return std::nullopt;
+  return w;
+}
+
+}  // namespace
+
+std::optional<LeadSilhouette> Renderer::lead_silhouette(const CameraView& view, const LeadPose& lead,
+                                                        int max_side) {
+  Impl& I = *impl_;
+  if (I.lead_meshes.empty()) return std::nullopt;
+  Eigen::AlignedBox3f box;
+  for (const GpuMesh& m : I.lead_meshes)
+    for (const Chunk& c : m.chunks) box.extend(c.box);
+  const Eigen::Matrix4d M = model_matrix(lead);
+  const auto window = silhouette_window(box, M, view, I.info.near, max_side);
+  if (!window) return std::nullopt;
+  ctx_.make_current();
+  auto& gl = I.gl;
+  const int w = window->width, h = window->height;
+  int side = 64;  // targets by powers of two: a few sizes over a flight, each made once
+  while (side < std::max(w, h)) side *= 2;
+  Target& t = I.target(side, side);
+  const auto& cam = view.camera;
+  const Eigen::Matrix4f P = to_float(projection(cam.fx(), cam.fy(), cam.cx() - window->x, cam.cy() - window->y,
+                                                w, h, I.info.near, I.info.far, I.depth.reversed));
+  Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
+  V.topLeftCorner<3, 3>() = view.pose.R_CW;
+  V.topRightCorner<3, 1>() = -view.pose.R_CW * view.pose.position;
+  if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+  gl.Viewport(0, 0, w, h);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(I.depth.reversed ? GL_GREATER : GL_LESS);
+  gl.Disable(GL_CULL_FACE);
+  gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
+  gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  I.draw_meshes(Impl::Pass{false, P, V, nullptr}, I.lead_meshes, M);
+  gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  gl.BindVertexArray(0);
+  LeadSilhouette s;
+  s.window = *window;
+  s.depth.create(h, w, CV_32F);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
+  gl.ReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, s.depth.data);
+  to_metric_depth(s.depth, I.depth);
+  if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
+    throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while drawing the lead alone");
+  return s;
+}
+
 // Remap tables from the distorted image to a wider pinhole canvas.
 struct Renderer::Undistort {
   double cx = 0, cy = 0;  // principal point on the canvas

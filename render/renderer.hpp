@@ -33,6 +33,15 @@ struct CameraView {
   std::vector<LeadPose> bodies{};
 };
 
+// The lead drawn alone, depth only, over the window of the image plane its model's box projects
+// to: what it would cover with nothing in front of it and no image border (ground truth of how much
+// of it a frame shows). Pixels are the undistorted (pinhole) image's; the window may reach past the
+// image's edges.
+struct LeadSilhouette {
+  cv::Rect window;  // pinhole pixels; depth's (0, 0) is pixel (window.x, window.y)
+  cv::Mat depth;    // CV_32FC1, metres along the optical axis; 0 off the lead
+};
+
 struct Frame {
   cv::Mat rgb;    // CV_8UC3, RGB order
   cv::Mat depth;  // CV_32FC1, metres along the optical axis; 0: no surface
@@ -51,6 +60,10 @@ class Renderer {
   // Rows [row0, row0 + rows) of that image, and only they are drawn (a rolling shutter's band):
   // the same pixels as render()'s rows; all of them is render() itself.
   Frame render_rows(const CameraView& view, const std::optional<LeadPose>& lead, int row0, int rows);
+  // Nothing when the scene has no lead model or the lead is wholly behind the camera. A window
+  // wider or taller than max_side px is cut to the image and a margin of max_side / 4 around it.
+  std::optional<LeadSilhouette> lead_silhouette(const CameraView& view, const LeadPose& lead,
+                                                int max_side = 2048);
   const GlContext& context() const { return ctx_; }
 
   // The OpenGL projection matrix for an undistorted w x h image with these intrinsics

@@ -23,6 +23,7 @@
 #include "io/results_dir.hpp"
 #include "geometry/rotation.hpp"
 #include "app/pipeline/camera_imaging.hpp"
+#include "app/pipeline/lead_label.hpp"
 #include "render/gl_context.hpp"
 #include "render/renderer.hpp"
 #include "render/scene.hpp"
@@ -189,6 +190,8 @@ int render_command(const RenderOptions& o, const std::string& variant) {
       const geometry::CameraPose& centre = f.poses.centre();
       writer.write_frame(u.name, t_ns, f.frame.rgb, f.frame.depth);
       writer.camera_pose(u.name, pose(t_ns, centre.position, centre.R_CW));
+      const auto silhouette = renderer.lead_silhouette({imaging[j].model(), centre}, lead);
+      writer.lead_label(u.name, {t_ns, app::lead_label(lk.position, imaging[j].model(), f.poses, f.frame.depth, silhouette)});
       writer.exposure(u.name, {t_ns, f.exposure.exposure_s, f.exposure.gain});
       if (u.altimeter) writer.altimeter(u.name, {t_ns, sensors.altimeter(j, t)});
       if (u.range) writer.range(u.name, {t_ns, sensors.range(j, t)});

@@ -13,6 +13,7 @@
 #include "eval/metrics/run_record.hpp"
 #include "geometry/camera.hpp"
 #include "geometry/frame_poses.hpp"
+#include "geometry/lead_image.hpp"
 #include "geometry/pose.hpp"
 #include "render/renderer.hpp"
 
@@ -22,6 +23,7 @@ namespace wingman::app {
 struct CameraFrame {
   render::Frame frame;
   geometry::FramePoses true_pose;
+  std::optional<geometry::LeadImage> lead_truth;  // the lead in this frame, when known
 };
 
 class GroundTruthLabeller {

@@ -49,6 +49,7 @@ class CameraImaging {
   // A global shutter with no exposure time: one render at the frame's time, the same for every
   // run of a seed-free truth (a frame cache may hold it).
   bool instant() const;
+  const geometry::PinholeCamera& model() const { return model_; }
 
  private:
   // The next frame's exposure time: the sensor's (auto-exposure's) when it is physical, the

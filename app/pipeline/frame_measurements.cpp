@@ -46,6 +46,12 @@ StageTimes FrameMeasurements::begin_step(int k, double t, const slam::Estimator&
     lead_[j] = frontend_.lead(j);
     record_.searched_fraction_sum += frontend_.searched_fraction(j);
     const auto uv_true = labeller_.lead(lead_[j], frontend_.model(j), now_[j], lead_W, record_);
+    eval::LeadFrameRecord row;
+    row.k = k, row.t = t, row.cam = j;
+    if (lead_[j]) row.detected = *lead_[j];
+    row.has_truth = now_[j].lead_truth.has_value();
+    if (row.has_truth) row.truth = *now_[j].lead_truth;
+    record_.lead_frames.push_back(row);
     if (uv_true && cfg_.frontend.oracle_pixels) lead_[j] = *uv_true;
   }
   return st;

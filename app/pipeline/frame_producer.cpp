@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "datasets/dataset.hpp"
+#include "app/pipeline/lead_label.hpp"
 #include "render/effects.hpp"
 #include "render/frame_cache.hpp"
 #include "render/renderer.hpp"
@@ -39,13 +40,17 @@ RendererFrames::~RendererFrames() = default;
 
 std::string RendererFrames::description() const { return ctx_->description(); }
 
-render::Frame RendererFrames::render(const render::CameraView& view, const render::LeadPose& lead, int row0,
-                                     int rows) {
-  if (!renderer_) {  // the first frame the cache did not hold
+render::Renderer& RendererFrames::renderer() {
+  if (!renderer_) {  // the first frame the cache did not hold, or the first lead label
     renderer_ = std::make_unique<render::Renderer>(*ctx_, *scene_);
     scene_.reset();
   }
-  return renderer_->render_rows(view, lead, row0, rows);
+  return *renderer_;
+}
+
+render::Frame RendererFrames::render(const render::CameraView& view, const render::LeadPose& lead, int row0,
+                                     int rows) {
+  return renderer().render_rows(view, lead, row0, rows);
 }
 
 void RendererFrames::produce(int cam, int, double t, CameraFrame& out) {
@@ -63,6 +68,10 @@ void RendererFrames::produce(int cam, int, double t, CameraFrame& out) {
   });
   out.frame = std::move(f.frame);
   out.true_pose = std::move(f.poses);
+  // The lead's label: its silhouette drawn alone at the frame's time (a small window, never cached).
+  const render::LeadPose lead = sim::lead_pose(truth_, t, cfg_.world);
+  const auto silhouette = renderer().lead_silhouette({imaging.model(), out.true_pose.centre()}, lead);
+  out.lead_truth = lead_label(truth_.lead(t).position, imaging.model(), out.true_pose, out.frame.depth, silhouette);
 }
 
 void RendererFrames::finish(eval::FrontendRecord& rec) const {
@@ -84,6 +93,8 @@ void DatasetFrames::produce(int cam, int k, double t, CameraFrame& out) {
   if (img.channels() == 1) cv::cvtColor(img, img, cv::COLOR_GRAY2RGB);
   out.frame.rgb = img;
   out.frame.depth = ds_.load_depth(a.name, a.frames[k]);
+  out.lead_truth.reset();  // datasets rendered before labels were written have none
+  if (!a.lead_labels.empty()) out.lead_truth = a.lead_labels[k].lead;
 }
 
 }  // namespace wingman::app

@@ -66,6 +66,7 @@ class RendererFrames final : public FrameProducer {
   void finish(eval::FrontendRecord& rec) const override;
 
  private:
+  render::Renderer& renderer();  // made at the first use: a run the cache holds whole uploads once
   render::Frame render(const render::CameraView& view, const render::LeadPose& lead, int row0, int rows);
 
   const RunConfig& cfg_;

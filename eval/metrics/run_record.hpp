@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "geometry/lead_image.hpp"
+
 namespace wingman::eval {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -159,6 +161,16 @@ struct TrackedCorrespondence {
   bool accepted = false;  // by the filter's RANSAC and gate
 };
 
+// One camera frame's lead detection beside the lead's ground truth (lead.csv).
+struct LeadFrameRecord {
+  int k = 0;
+  double t = 0;
+  int cam = 0;
+  Eigen::Vector2d detected = Eigen::Vector2d::Constant(kNaN);  // NaN: nothing detected
+  bool has_truth = false;  // false: a replay of a dataset without cam0_lead0
+  geometry::LeadImage truth;
+};
+
 // A run's use of the frame cache (render/frame_cache.hpp); provenance and timing, not a result.
 struct FrameCacheRecord {
   bool used = false;
@@ -193,6 +205,7 @@ struct FrontendRecord {
   // Every tracked correspondence, when asked for (about 83 000 on the 210 s paper scene, multi-UAV).
   bool record_correspondences = false;
   std::vector<TrackedCorrespondence> correspondences;
+  std::vector<LeadFrameRecord> lead_frames;  // every camera frame, in order
   FrameCacheRecord frame_cache;
 };
 

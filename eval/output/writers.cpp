@@ -326,6 +326,32 @@ void write_correspondences_csv(const RunRecord& run, const fs::path& path) {
   write_file(path, fmt::to_string(b));
 }
 
+void write_lead_csv(const RunRecord& run, const fs::path& path) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  fmt::format_to(out, "k,t,cam,u,v,true_u,true_v,distance,visible,box_u0,box_v0,box_u1,box_v1\n");
+  auto pixel = [&](const Eigen::Vector2d& p) {
+    if (p.allFinite())
+      fmt::format_to(out, "{:.6f},{:.6f}", p.x(), p.y());
+    else
+      fmt::format_to(out, ",");
+  };
+  for (const LeadFrameRecord& f : run.frontend.lead_frames) {
+    fmt::format_to(out, "{},{:.9g},{},", f.k, f.t, f.cam);
+    pixel(f.detected);
+    fmt::format_to(out, ",");
+    if (!f.has_truth) {
+      fmt::format_to(out, ",,,,,,,\n");
+      continue;
+    }
+    const geometry::LeadImage& x = f.truth;
+    pixel(x.uv);
+    fmt::format_to(out, ",{:.6f},{:.6f},{},{},{},{}\n", x.distance, x.visible, x.box_u0, x.box_v0, x.box_u1,
+                   x.box_v1);
+  }
+  write_file(path, fmt::to_string(b));
+}
+
 void write_map_ply(const RunRecord& run, const fs::path& path, MapPoints which) {
   std::vector<const LandmarkRecord*> kept;
   for (const LandmarkRecord& l : run.landmarks) {
@@ -364,6 +390,7 @@ void write_results(const Metrics& metrics, const RunRecord& run, const fs::path&
   write_formation_csv(run, dir / "formation.csv");
   if (run.frontend.record_correspondences)
     write_correspondences_csv(run, dir / "correspondences.csv");
+  if (!run.frontend.lead_frames.empty()) write_lead_csv(run, dir / "lead.csv");
 }
 
 namespace {

@@ -35,6 +35,10 @@ void write_landmarks_csv(const RunRecord& run, const std::filesystem::path& path
 // k, t, cam, landmark, u, v, true_u, true_v (empty when the landmark has no truth), outlier,
 // accepted. write_results writes it only when the run recorded them.
 void write_correspondences_csv(const RunRecord& run, const std::filesystem::path& path);
+// lead.csv: every camera frame's lead detection (u, v; empty when none) beside the lead's truth
+// (x_h's projection, distance, visible share, the visible pixels' box; empty in a replay of a
+// dataset without labels).
+void write_lead_csv(const RunRecord& run, const std::filesystem::path& path);
 
 // ASCII PLY of the landmarks still in the map at the end (t_removed NaN): their final
 // estimates coloured by origin (MapPoints::estimate), or their truth points (MapPoints::truth).

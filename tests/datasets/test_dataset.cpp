@@ -80,6 +80,12 @@ Written write_small(const fs::path& dir, int channels = 3, double k3 = 0) {
     w.altimeter("uav1", {t, 15.25});
     w.range("uav1", {t, 15.5});
     w.ahrs("uav1", {t, 0.0625});
+    geometry::LeadImage lead;
+    if (k < 2) lead.uv = {30.25 + k, 20.5};  // frame 2: x_h behind the camera
+    lead.distance = 15.5;
+    lead.visible = k == 0 ? 1.0 : 0.375;
+    if (k < 2) lead.box_u0 = 25, lead.box_v0 = 16, lead.box_u1 = 36, lead.box_v1 = 27;
+    w.lead_label("uav1", {t, lead});
   }
   w.finish();
   return out;
@@ -179,6 +185,36 @@ TEST(Dataset, TheShutterIsReadBackAndABadOneNamesTheFile) {
       ADD_FAILURE() << to;
     } catch (const DatasetError& e) {
       EXPECT_EQ(std::string(e.what()), yaml.string() + ": " + message);
+    }
+  }
+}
+
+TEST(Dataset, TheLeadsLabelsAreReadBackAndAMalformedRowNamesTheFileAndLine) {
+  TempDir a;
+  write_small(a.path);
+  const auto& labels = read_dataset(a.path).agent("uav1").lead_labels;
+  ASSERT_EQ(labels.size(), 3u);
+  EXPECT_EQ(labels[1].t_ns, step_ns(1, 10));
+  EXPECT_DOUBLE_EQ(labels[1].lead.uv.x(), 31.25);
+  EXPECT_DOUBLE_EQ(labels[1].lead.visible, 0.375);
+  EXPECT_EQ(labels[1].lead.box_u1, 36);
+  EXPECT_TRUE(std::isnan(labels[2].lead.uv.x()));
+  EXPECT_TRUE(read_dataset(a.path).agent("lead").lead_labels.empty());
+  const fs::path csv = a.path / "uav1" / "mav0" / "cam0_lead0" / "data.csv";
+  const std::string good = slurp(csv);
+  for (const auto& [from, to, message] :
+       {std::tuple{",0.375,", ",1.5,", "data row 2: distance must be >= 0 and visible in [0, 1]"},
+        std::tuple{",25,16,36,27\n100000000", ",25.5,16,36,27\n100000000", "data row 1: box bound 25.5 is not a whole pixel"},
+        std::tuple{"100000000,", "100000001,", "data row 2: time stamp 100000001 is not frame 2's"}}) {
+    std::string s = good;
+    const auto pos = s.find(from);
+    ASSERT_NE(pos, std::string::npos) << from;
+    std::ofstream(csv) << s.replace(pos, std::string(from).size(), to);
+    try {
+      read_dataset(a.path);
+      ADD_FAILURE() << to;
+    } catch (const DatasetError& e) {
+      EXPECT_EQ(std::string(e.what()), csv.string() + ": " + message);
     }
   }
 }
