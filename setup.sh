@@ -3,6 +3,8 @@
 #   bash setup.sh run    install packages, build wingman, run the default scenario (scenes/paper_synthetic.yaml)
 #   bash setup.sh test   install packages, build, run every test (what CI runs)
 #   bash setup.sh build  install packages and build only
+#   bash setup.sh train  install packages and the lead detector's training packages, build
+#                        (then tools/lead_data.py and tools/train_lead_detector.py, docs/frontend.md)
 # Environment: BUILD_DIR (default build), JOBS (default: all cores), WINGMAN_SKIP_APT=1 to skip apt.
 set -euo pipefail
 
@@ -24,6 +26,9 @@ packages=(
   python3-rosbag python3-std-msgs python3-geometry-msgs python3-sensor-msgs python3-nav-msgs python3-tf2-msgs
   slurm-wlm munge
 )
+
+# Only the lead detector's training (tools/train_lead_detector.py) and its test need these.
+training_packages=(python3-torch python3-onnx python3-opencv python3-numpy)
 
 install_packages() {
   [ "${WINGMAN_SKIP_APT:-0}" = 1 ] && return 0
@@ -57,13 +62,19 @@ case "$mode" in
     "$build_dir/app/wingman" run scenes/paper_synthetic.yaml --out results/paper_synthetic "$@"
     ;;
   test)
+    packages+=("${training_packages[@]}")
     install_packages
     build
     cd "$build_dir"
     ctest --output-on-failure -j "$jobs"
     ;;
+  train)
+    packages+=("${training_packages[@]}")
+    install_packages
+    build
+    ;;
   *)
-    echo "usage: bash setup.sh [build|run|test]" >&2
+    echo "usage: bash setup.sh [build|run|test|train]" >&2
     exit 2
     ;;
 esac

@@ -22,7 +22,7 @@
 
 namespace wingman::frontend_bench {
 
-// A pairs, keypoints or matches file that cannot be used: "<file>:<line>: what".
+// A pairs, keypoints, matches or lead detections file that cannot be used: "<file>:<line>: what".
 class MatchInputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;

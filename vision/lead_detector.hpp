@@ -52,7 +52,7 @@ struct LeadDetectorSettings {
   void validate() const;  // throws std::invalid_argument naming the bad value
 };
 
-enum class LeadSource { Marker, Colour };
+enum class LeadSource { Marker, Colour, Learned };
 
 struct LeadDetection {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // the reference point, docs/design.md, frames and conventions pixels
@@ -62,17 +62,26 @@ struct LeadDetection {
   LeadSource source = LeadSource::Marker;
   std::array<Eigen::Vector2d, 4> corners{};  // marker corners (clockwise from top-left of the
                                              // marker), zero for colour blobs
-  double size_px = 0;  // mean side (marker) or sqrt(area) (colour)
+  double size_px = 0;  // mean side (marker) or sqrt(area) (colour); 0: not measured (learned)
 };
 
-class LeadDetector {
+// What finds the lead in a frame: a marker or a colour panel (LeadDetector), or the lead itself
+// (LearnedLeadDetector). With a prediction, the detection nearest to it, searched near it first.
+class LeadFinder {
+ public:
+  virtual ~LeadFinder() = default;
+  virtual std::optional<LeadDetection> detect(const cv::Mat& image,
+                                              const std::optional<Eigen::Vector2d>& predicted = std::nullopt) const = 0;
+};
+
+class LeadDetector final : public LeadFinder {
  public:
   explicit LeadDetector(const LeadDetectorSettings& settings = {});
   const LeadDetectorSettings& settings() const { return cfg_; }
   // `image`: 8-bit BGR (as cv::imread) or grey (no colour fallback then). With a prediction,
   // the detection nearest to it is returned when several qualify.
   std::optional<LeadDetection> detect(const cv::Mat& image,
-                                      const std::optional<Eigen::Vector2d>& predicted = std::nullopt) const;
+                                      const std::optional<Eigen::Vector2d>& predicted = std::nullopt) const override;
 
  private:
   std::optional<LeadDetection> detect_marker(const cv::Mat& grey,

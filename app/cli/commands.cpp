@@ -45,6 +45,7 @@ int run_cli(int argc, char** argv) {
       add_render(cli),
       add_slam(cli),
       add_bench_frontend(cli),
+      add_bench_lead(cli),
       add_pairs(cli),
       add_score_matches(cli),
       add_baseline(cli),

@@ -24,6 +24,7 @@ Subcommand add_observability(CLI::App& parent);  // app/cli/cmd_observability.cp
 Subcommand add_render(CLI::App& parent);         // app/cli/cmd_render.cpp
 Subcommand add_slam(CLI::App& parent);           // app/cli/cmd_slam.cpp
 Subcommand add_bench_frontend(CLI::App& parent); // app/cli/cmd_bench_frontend.cpp
+Subcommand add_bench_lead(CLI::App& parent);     // app/cli/cmd_bench_lead.cpp
 Subcommand add_pairs(CLI::App& parent);          // app/cli/cmd_score_matches.cpp
 Subcommand add_score_matches(CLI::App& parent);  // app/cli/cmd_score_matches.cpp
 Subcommand add_baseline(CLI::App& parent);       // app/cli/cmd_baseline.cpp

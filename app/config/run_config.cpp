@@ -168,7 +168,40 @@ void check_phase_sensors(const RunConfig& cfg) {
   }
 }
 
+// The lead detector's own checks: a marker or panel detector needs that cue in the world; the
+// learned one needs its weights, which must load as a network of the expected shape.
+void resolve_lead_detector(RunConfig& cfg, const Provenance& prov) {
+  using K = vision::LeadDetectorKind;
+  using Cue = sim::LeadModelSpec::Cue;
+  const K kind = lead_detector(cfg);
+  const sim::Loc* key = prov.find("frontend", "lead_detector");
+  if (kind == K::Aruco && cfg.world.lead.cue != Cue::Aruco)
+    fail_at(prov, cfg, key, "aruco finds the lead's marker: it needs world.lead.cue: aruco");
+  if (kind == K::Panel && cfg.world.lead.cue != Cue::Panel)
+    fail_at(prov, cfg, key, "panel finds the lead's colour panel: it needs world.lead.cue: panel");
+  if (kind != K::Learned || cfg.measurements != sim::MeasurementMode::Rendered) return;
+  const sim::Loc* weights = prov.find("frontend", "learned_lead.weights");
+  try {
+    cfg.lead_weights_path = sim::resolve_asset(cfg.frontend.learned_lead.weights, cfg.source_path,
+                                               "lead detector weights");
+    const vision::LearnedLeadDetector check(cfg.lead_weights_path, cfg.frontend.learned_lead.search);
+  } catch (const std::runtime_error& e) {  // not found, or vision::LeadModelError
+    fail_at(prov, cfg, weights, e.what());
+  }
+}
+
 }  // namespace
+
+vision::LeadDetectorKind lead_detector(const RunConfig& cfg) {
+  using K = vision::LeadDetectorKind;
+  if (cfg.frontend.lead_detector != K::Auto) return cfg.frontend.lead_detector;
+  switch (cfg.world.lead.cue) {
+    case sim::LeadModelSpec::Cue::Aruco: return K::Aruco;
+    case sim::LeadModelSpec::Cue::Panel: return K::Panel;
+    case sim::LeadModelSpec::Cue::None: return K::Learned;
+  }
+  return K::Aruco;
+}
 
 std::vector<int> RunConfig::filter_uavs() const {
   if (single_uav()) return {uav_index(estimator.single_uav)};
@@ -185,6 +218,7 @@ RunConfig compose(const sim::Scenario& scenario) {
   resolve_estimator(cfg, prov);
   check_phase_sensors(cfg);
   derive_noise(cfg, prov);
+  resolve_lead_detector(cfg, prov);
   return cfg;
 }
 

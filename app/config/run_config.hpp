@@ -19,11 +19,18 @@ struct RunConfig : sim::Scenario {
   slam::EstimatorSettings estimator{};
   vision::FrontendSettings frontend{};
   control::SlidingModeSettings controller{};  // closed loop: the control: section's gains and limits
+  // frontend.learned_lead.weights as found (next to the scenario or in assets/), when the lead
+  // detector is the learned one; checked to load when the configuration is read.
+  std::string lead_weights_path;
 
   bool single_uav() const { return estimator.mode == slam::EstimatorMode::SingleUav; }
   // UAV index of each camera in the filter: every UAV (multi) or the baseline's (single).
   std::vector<int> filter_uavs() const;
 };
+
+// The lead detector a rendered run uses: frontend.lead_detector, or for auto the one the world's
+// cue calls for (aruco, panel; learned for cue: none).
+vision::LeadDetectorKind lead_detector(const RunConfig& cfg);
 
 // Loads a scenario file: one configuration per variant (or one), validated as a whole; errors
 // are sim::ScenarioError naming file:line:col and the key.

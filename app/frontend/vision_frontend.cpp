@@ -10,22 +10,20 @@ namespace wingman::app {
 
 namespace {
 
-vision::LeadDetectorSettings lead_settings(const RunConfig& cfg) {
-  vision::LeadDetectorSettings s;
-  switch (cfg.world.lead.cue) {
-    case sim::LeadModelSpec::Cue::Aruco:
-      s.method = vision::LeadMethod::Marker;
-      s.marker_id = cfg.world.lead.aruco_id;
-      break;
-    case sim::LeadModelSpec::Cue::Panel:
-      s.method = vision::LeadMethod::Colour;
-      break;
-    case sim::LeadModelSpec::Cue::None:
-      throw std::invalid_argument(cfg.source_path +
-                                  ": world.lead.cue: none leaves the lead detector nothing to find "
-                                  "(rendered measurements need aruco or panel)");
+// The lead detector lead_detector(cfg) names: the marker's (with the world's marker id), the colour
+// panel's, or the learned network (its weights checked when the configuration was read).
+std::unique_ptr<vision::LeadFinder> make_lead_finder(const RunConfig& cfg) {
+  using K = vision::LeadDetectorKind;
+  const K kind = lead_detector(cfg);
+  if (kind == K::Learned) {
+    if (cfg.lead_weights_path.empty())
+      throw std::invalid_argument(cfg.source_path + ": the learned lead detector's weights were not resolved");
+    return std::make_unique<vision::LearnedLeadDetector>(cfg.lead_weights_path, cfg.frontend.learned_lead.search);
   }
-  return s;
+  vision::LeadDetectorSettings s;
+  s.method = kind == K::Panel ? vision::LeadMethod::Colour : vision::LeadMethod::Marker;
+  s.marker_id = cfg.world.lead.aruco_id;
+  return std::make_unique<vision::LeadDetector>(s);
 }
 
 // Box kept free of map features around the lead: its detection, or else its predicted pixel,
@@ -55,11 +53,11 @@ VisionFrontend::VisionFrontend(const RunConfig& cfg, const std::vector<int>& cam
                                const std::optional<vision::FeatureSettings>& features)
     : cfg_(cfg),
       features_(features ? *features : cfg.frontend.features),
-      lead_(lead_settings(cfg)),
+      lead_(make_lead_finder(cfg)),
       tracking_(cfg.frontend.tracking),
       cross_(cross_match_settings(cfg)) {
   tracking_.validate();
-  colour_lead_ = lead_.settings().method != vision::LeadMethod::Marker;
+  colour_lead_ = lead_detector(cfg) == vision::LeadDetectorKind::Panel;
   for (int u : cam_uav) {
     Cam c;
     c.model = cfg.uavs[u].camera.camera();
@@ -78,12 +76,14 @@ double VisionFrontend::detect(int cam, const render::Frame& frame, const slam::E
   const cv::Mat grey = frame.gray();
   cv::Mat bgr;
   if (colour_lead_) cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
-  const auto det = lead_.detect(colour_lead_ ? bgr : grey, predicted);
+  const auto det = lead_->detect(colour_lead_ ? bgr : grey, predicted);
   c.lead.reset();
   std::vector<vision::ExclusionBox> exclude;
   if (det) {
     c.lead = det->uv;
-    exclude.push_back(vision::exclusion_box(*det));
+    // A detection without a size (the learned detector's point) keeps the model's footprint free.
+    exclude.push_back(det->size_px > 0 ? vision::exclusion_box(*det)
+                                       : predicted_lead_box(det->uv, c.model.fx(), p_est.z(), cfg_));
   } else if (predicted) {
     exclude.push_back(predicted_lead_box(*predicted, c.model.fx(), p_est.z(), cfg_));
   }

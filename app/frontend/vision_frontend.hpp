@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -91,7 +92,7 @@ class VisionFrontend {
                                      const slam::Estimator& est) const;
   const RunConfig& cfg_;
   vision::FeatureExtractor features_;
-  vision::LeadDetector lead_;
+  std::unique_ptr<vision::LeadFinder> lead_;
   vision::TrackingSettings tracking_;
   vision::CrossMatchSettings cross_;
   vision::DescriptorStore store_;
