@@ -6,6 +6,7 @@ scenario this tool writes (kept beside it as scenario.yaml); its cam0_lead0 labe
 
   tools/lead_data.py --wingman build/app/wingman --out DIR [--per-pair 2] [--duration 30]
                      [--rate 2] [--grounds freetown,naip,park,site] [--leads truck,person,quadrotor]
+                     [--seed 1] [--cue none|aruco]
 
 DIR/<ground>_<lead>_<seed>_<i>/ is one dataset. Everything drawn comes from --seed, so the same command
 writes the same datasets. An existing DIR is refused (nothing is replaced)."""
@@ -29,16 +30,16 @@ GROUNDS = {
 # the lead and the camera (the shipped scenes' for that lead).
 LEADS = {
     "truck": dict(model="models/cesium_milk_truck/CesiumMilkTruck.glb", kind="ground", height=2.6, up="y",
-                  yaw=0.0, z=0.0, above=(11.0, 20.0),
+                  yaw=0.0, z=0.0, above=(11.0, 20.0), marker=1.8,
                   camera="{fx: 200.1, fy: 200.1, cx: 500, cy: 500, width: 1000, height: 1000}"),
     "person": dict(model="models/human/HUMAN.glb", kind="ground", height=1.8, up="z", yaw=1.5708, z=0.0,
-                   above=(6.5, 12.0), camera="{fx: 420, fy: 420, cx: 319.5, cy: 239.5, width: 640, height: 480}"),
+                   above=(6.5, 12.0), marker=0.6, camera="{fx: 420, fy: 420, cx: 319.5, cy: 239.5, width: 640, height: 480}"),
     "quadrotor": dict(model="models/quadrotor/quadrotor.obj", kind="aerial", height=0.28, up="z", yaw=0.0, z=5.0,
-                      above=(5.0, 9.0), camera="{fx: 420, fy: 420, cx: 319.5, cy: 239.5, width: 640, height: 480}"),
+                      above=(5.0, 9.0), marker=0.45, camera="{fx: 420, fy: 420, cx: 319.5, cy: 239.5, width: 640, height: 480}"),
 }
 
 
-def scenario(name, ground, lead, rng, duration, rate):
+def scenario(name, ground, lead, rng, duration, rate, cue):
     L = LEADS[lead]
     uavs = []
     for i in (1, 2):
@@ -57,7 +58,7 @@ def scenario(name, ground, lead, rng, duration, rate):
     objects = rng.choice(["{boulders: 25, trees: 12, buildings: 2, clearance: 8}",
                           "{boulders: 0, trees: 0, buildings: 0, clearance: 8}"])
     scale = rng.uniform(25, 60)
-    return f"""# Lead-detector training data (tools/lead_data.py): {ground} ground, {lead}, no cue.
+    return f"""# Lead-detector data (tools/lead_data.py): {ground} ground, {lead}, cue {cue}.
 name: {name}
 duration: {duration}
 rate: {rate}
@@ -78,7 +79,7 @@ world:
   texture: {GROUNDS[ground]}
   objects: {objects}
   lead: {{model: {L["model"]}, kind: {L["kind"]}, height: {L["height"]}, up: {L["up"]}, yaw_offset: {L["yaw"]},
-         cue: none}}
+         cue: {cue}{f", marker_size: {L['marker']}" if cue == "aruco" else ""}}}
   light: {{ambient: {rng.uniform(0.3, 0.5):.2f}, diffuse: {rng.uniform(0.5, 0.8):.2f},
           sun: {{enabled: true, latitude: {rng.uniform(-50, 50):.1f}, longitude: 0, day_of_year: {rng.randrange(1, 366)},
                 time_utc: {sun_time:.2f}}},
@@ -97,6 +98,8 @@ def main():
     ap.add_argument("--duration", type=float, default=30)
     ap.add_argument("--rate", type=float, default=2)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--cue", default="none", choices=["none", "aruco"],
+                    help="aruco: the same scenes with the marker, the reference detector's data")
     a = ap.parse_args()
     if os.path.exists(a.out):
         sys.exit(f"lead_data: {a.out} exists; give a new directory")
@@ -126,7 +129,7 @@ def render_all(a, rng, staging):
                     name = f"{g}_{l}_{a.seed}_{i}"
                     path = os.path.join(tmp, name + ".yaml")
                     with open(path, "w") as f:
-                        f.write(scenario(name, g, l, rng, a.duration, a.rate))
+                        f.write(scenario(name, g, l, rng, a.duration, a.rate, a.cue))
                     print(f"[lead_data] {name}", flush=True)
                     subprocess.run([a.wingman, "render", path, "--out", os.path.join(staging, name), "--gray",
                                     "--quiet"], check=True)

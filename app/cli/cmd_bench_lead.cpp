@@ -17,6 +17,7 @@
 #include "app/cli/cli_options.hpp"
 #include "app/cli/subcommand.hpp"
 #include "app/config/run_config.hpp"
+#include "app/frontend/vision_frontend.hpp"
 #include "datasets/dataset.hpp"
 #include "frontend_bench/lead_scores.hpp"
 #include "io/atomic_file.hpp"
@@ -60,28 +61,24 @@ RunConfig dataset_scenario(const datasets::Dataset& ds) {
 // The detector --detector names (auto: the dataset's scenario's), with --weights and --threshold.
 std::unique_ptr<vision::LeadFinder> make_detector(const BenchLeadOptions& o, const RunConfig& cfg, std::string& name) {
   using K = vision::LeadDetectorKind;
-  K kind = lead_detector(cfg);
-  if (o.detector == "aruco") kind = K::Aruco;
-  if (o.detector == "panel") kind = K::Panel;
-  if (o.detector == "learned") kind = K::Learned;
-  if (kind == K::Learned) {
-    vision::LearnedLeadSettings s = cfg.frontend.learned_lead.search;
-    if (o.threshold > 0) s.threshold = o.threshold;
-    std::string weights = o.weights;
-    try {
-      if (weights.empty()) weights = sim::resolve_asset(cfg.frontend.learned_lead.weights, cfg.source_path,
-                                                        "lead detector weights");
-      name = "learned (" + weights + ")";
-      return std::make_unique<vision::LearnedLeadDetector>(weights, s);
-    } catch (const std::runtime_error& e) {
-      throw io::UsageError(fmt::format("--weights: {}", e.what()));
+  const K kind = o.detector == "aruco"     ? K::Aruco
+                 : o.detector == "panel"   ? K::Panel
+                 : o.detector == "learned" ? K::Learned
+                                           : lead_detector(cfg);
+  vision::LearnedLeadSettings learned = cfg.frontend.learned_lead.search;
+  if (o.threshold > 0) learned.threshold = o.threshold;
+  std::string weights;
+  try {
+    if (kind == K::Learned) {
+      weights = o.weights.empty() ? sim::resolve_asset(cfg.frontend.learned_lead.weights, cfg.source_path,
+                                                       "lead detector weights")
+                                  : o.weights;
     }
+    name = kind == K::Learned ? "learned (" + weights + ")" : kind == K::Panel ? "panel" : "aruco";
+    return make_lead_finder(cfg, kind, weights, learned);
+  } catch (const std::runtime_error& e) {  // not found, or vision::LeadModelError
+    throw io::UsageError(fmt::format("--weights: {}", e.what()));
   }
-  vision::LeadDetectorSettings s;
-  s.method = kind == K::Panel ? vision::LeadMethod::Colour : vision::LeadMethod::Marker;
-  s.marker_id = cfg.world.lead.aruco_id;
-  name = kind == K::Panel ? "panel" : "aruco";
-  return std::make_unique<vision::LeadDetector>(s);
 }
 
 // Every camera frame of a dataset with its truth; detected by `detector` unless it is null.

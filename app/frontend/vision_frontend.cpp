@@ -10,22 +10,6 @@ namespace wingman::app {
 
 namespace {
 
-// The lead detector lead_detector(cfg) names: the marker's (with the world's marker id), the colour
-// panel's, or the learned network (its weights checked when the configuration was read).
-std::unique_ptr<vision::LeadFinder> make_lead_finder(const RunConfig& cfg) {
-  using K = vision::LeadDetectorKind;
-  const K kind = lead_detector(cfg);
-  if (kind == K::Learned) {
-    if (cfg.lead_weights_path.empty())
-      throw std::invalid_argument(cfg.source_path + ": the learned lead detector's weights were not resolved");
-    return std::make_unique<vision::LearnedLeadDetector>(cfg.lead_weights_path, cfg.frontend.learned_lead.search);
-  }
-  vision::LeadDetectorSettings s;
-  s.method = kind == K::Panel ? vision::LeadMethod::Colour : vision::LeadMethod::Marker;
-  s.marker_id = cfg.world.lead.aruco_id;
-  return std::make_unique<vision::LeadDetector>(s);
-}
-
 // Box kept free of map features around the lead: its detection, or else its predicted pixel,
 // sized for the model's footprint at the camera's height (the model moves: features on it would
 // make landmarks that drift).
@@ -36,6 +20,21 @@ vision::ExclusionBox predicted_lead_box(const Eigen::Vector2d& uv, double fx, do
 }
 
 }  // namespace
+
+std::unique_ptr<vision::LeadFinder> make_lead_finder(const RunConfig& cfg, vision::LeadDetectorKind kind,
+                                                     const std::string& weights,
+                                                     const vision::LearnedLeadSettings& learned) {
+  using K = vision::LeadDetectorKind;
+  if (kind == K::Auto) kind = lead_detector(cfg);
+  if (kind == K::Learned) {
+    if (weights.empty()) throw std::invalid_argument(cfg.source_path + ": the learned lead detector has no weights file");
+    return std::make_unique<vision::LearnedLeadDetector>(weights, learned);
+  }
+  vision::LeadDetectorSettings s;
+  s.method = kind == K::Panel ? vision::LeadMethod::Colour : vision::LeadMethod::Marker;
+  s.marker_id = cfg.world.lead.aruco_id;
+  return std::make_unique<vision::LeadDetector>(s);
+}
 
 vision::CrossMatchSettings cross_match_settings(const RunConfig& cfg) {
   vision::CrossMatchSettings c = cfg.frontend.cross_matching;
@@ -53,7 +52,7 @@ VisionFrontend::VisionFrontend(const RunConfig& cfg, const std::vector<int>& cam
                                const std::optional<vision::FeatureSettings>& features)
     : cfg_(cfg),
       features_(features ? *features : cfg.frontend.features),
-      lead_(make_lead_finder(cfg)),
+      lead_(make_lead_finder(cfg, lead_detector(cfg), cfg.lead_weights_path, cfg.frontend.learned_lead.search)),
       tracking_(cfg.frontend.tracking),
       cross_(cross_match_settings(cfg)) {
   tracking_.validate();

@@ -26,6 +26,13 @@ namespace wingman::app {
 // the estimator's initialisation (validated).
 vision::CrossMatchSettings cross_match_settings(const RunConfig& cfg);
 
+// The lead detector of `kind` (auto: lead_detector(cfg)) with the scenario's marker id, or the
+// learned one from `weights` with `learned`'s search; throws vision::LeadModelError for weights that
+// do not load.
+std::unique_ptr<vision::LeadFinder> make_lead_finder(const RunConfig& cfg, vision::LeadDetectorKind kind,
+                                                     const std::string& weights,
+                                                     const vision::LearnedLeadSettings& learned);
+
 class VisionFrontend {
  public:
   // A keypoint the frontend proposes: for a landmark (id >= 0) or a new one (id -1).
