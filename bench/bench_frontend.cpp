@@ -19,6 +19,7 @@
 #include "vision/cross_match.hpp"
 #include "vision/features.hpp"
 #include "vision/lead_detector.hpp"
+#include "vision/learned_lead_detector.hpp"
 #include "vision/tracking.hpp"
 
 namespace {
@@ -287,6 +288,26 @@ void BM_LeadDetectorPredicted(benchmark::State& state) {
   if (!found) state.SkipWithError("marker not found");
 }
 BENCHMARK(BM_LeadDetectorPredicted)->Unit(benchmark::kMillisecond);
+
+// The learned lead detector (assets/lead/lead_detector.onnx) on the window it searches around a
+// prediction (192 x 192: the gated cost when the lead is in it) and on the whole 1000 x 1000 frame
+// (no prediction, or none found near it).
+const LearnedLeadDetector& learned() {
+  static const LearnedLeadDetector d(std::string(WINGMAN_SOURCE_DIR) + "/assets/lead/lead_detector.onnx");
+  return d;
+}
+
+void BM_LearnedLeadWindow(benchmark::State& state) {
+  const cv::Mat window = frame_a()(cv::Rect(400, 400, 192, 192)).clone();
+  for (auto _ : state) benchmark::DoNotOptimize(learned().detect(window));
+}
+BENCHMARK(BM_LearnedLeadWindow)->Unit(benchmark::kMillisecond);
+
+void BM_LearnedLeadWholeFrame(benchmark::State& state) {
+  const cv::Mat& img = frame_a();
+  for (auto _ : state) benchmark::DoNotOptimize(learned().detect(img));
+}
+BENCHMARK(BM_LearnedLeadWholeFrame)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

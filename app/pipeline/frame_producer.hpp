@@ -54,7 +54,8 @@ struct FrameCacheOptions {
 // std::invalid_argument naming the scenario for a broken world, render::GlError when no context.
 // With a frame cache, a frame the cache holds is read back instead of rendered (the sensor and the
 // image effects are applied either way; a frame with an exposure time or a rolling shutter is
-// always rendered), and the scene is uploaded to the context only when a frame misses.
+// always rendered). The scene is uploaded to the context at the first miss or the first lead label
+// (the lead drawn alone, never cached), so every run uploads it once.
 class RendererFrames final : public FrameProducer {
  public:
   RendererFrames(const RunConfig& cfg, std::vector<int> cam_uav, render::GlBackend backend,
