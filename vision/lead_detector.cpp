@@ -90,7 +90,7 @@ LeadDetector::LeadDetector(const LeadDetectorSettings& settings) : cfg_(settings
 }
 
 std::optional<LeadDetection> LeadDetector::detect(const cv::Mat& image,
-                                                  const std::optional<Eigen::Vector2d>& predicted) const {
+                                                  const std::optional<Eigen::Vector2d>& predicted) {
   if (image.empty()) throw std::invalid_argument("LeadDetector::detect: empty image");
   if (image.depth() != CV_8U)
     throw std::invalid_argument("LeadDetector::detect: expected an 8-bit image, got depth " +

@@ -52,7 +52,7 @@ struct LeadDetectorSettings {
   void validate() const;  // throws std::invalid_argument naming the bad value
 };
 
-enum class LeadSource { Marker, Colour, Learned };
+enum class LeadSource { Marker, Colour, Learned, Motion };
 
 struct LeadDetection {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // the reference point, docs/design.md, frames and conventions pixels
@@ -66,12 +66,14 @@ struct LeadDetection {
 };
 
 // What finds the lead in a frame: a marker or a colour panel (LeadDetector), or the lead itself
-// (LearnedLeadDetector). With a prediction, the detection nearest to it, searched near it first.
+// (LearnedLeadDetector, MotionLeadDetector). With a prediction, the detection nearest to it,
+// searched near it first. A finder may keep state from frame to frame (the motion detector keeps
+// earlier frames): one finder per camera, given its frames in order.
 class LeadFinder {
  public:
   virtual ~LeadFinder() = default;
   virtual std::optional<LeadDetection> detect(const cv::Mat& image,
-                                              const std::optional<Eigen::Vector2d>& predicted = std::nullopt) const = 0;
+                                              const std::optional<Eigen::Vector2d>& predicted = std::nullopt) = 0;
 };
 
 class LeadDetector final : public LeadFinder {
@@ -81,7 +83,7 @@ class LeadDetector final : public LeadFinder {
   // `image`: 8-bit BGR (as cv::imread) or grey (no colour fallback then). With a prediction,
   // the detection nearest to it is returned when several qualify.
   std::optional<LeadDetection> detect(const cv::Mat& image,
-                                      const std::optional<Eigen::Vector2d>& predicted = std::nullopt) const override;
+                                      const std::optional<Eigen::Vector2d>& predicted = std::nullopt) override;
 
  private:
   std::optional<LeadDetection> detect_marker(const cv::Mat& grey,

@@ -72,7 +72,7 @@ std::pair<double, Eigen::Vector2d> LearnedLeadDetector::peak(const cv::Mat& grey
 }
 
 std::optional<LeadDetection> LearnedLeadDetector::detect(const cv::Mat& image,
-                                                         const std::optional<Eigen::Vector2d>& predicted) const {
+                                                         const std::optional<Eigen::Vector2d>& predicted) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
     throw std::invalid_argument("LearnedLeadDetector::detect: expected an 8-bit grey or BGR image");
   cv::Mat grey = image;

@@ -39,7 +39,7 @@ class LearnedLeadDetector final : public LeadFinder {
   LearnedLeadDetector(const std::string& onnx_path, const LearnedLeadSettings& settings = {});
   // `image`: 8-bit grey (or BGR, turned grey).
   std::optional<LeadDetection> detect(const cv::Mat& image,
-                                      const std::optional<Eigen::Vector2d>& predicted = std::nullopt) const override;
+                                      const std::optional<Eigen::Vector2d>& predicted = std::nullopt) override;
   const LearnedLeadSettings& settings() const { return cfg_; }
 
  private:

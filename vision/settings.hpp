@@ -6,13 +6,14 @@
 #include "vision/cross_match.hpp"
 #include "vision/features.hpp"
 #include "vision/learned_lead_detector.hpp"
+#include "vision/motion_lead_detector.hpp"
 #include "vision/tracking.hpp"
 
 namespace wingman::vision {
 
 // Which detector finds the lead in each frame. auto: the world's cue decides (aruco: the marker,
-// panel: the colour panel, none: the learned detector).
-enum class LeadDetectorKind { Auto, Aruco, Panel, Learned };
+// panel: the colour panel, none: the learned detector); motion: what does not follow the ground.
+enum class LeadDetectorKind { Auto, Aruco, Panel, Learned, Motion };
 
 // frontend.learned_lead: the learned detector's network and search.
 struct LearnedLeadConfig {
@@ -25,6 +26,22 @@ struct LearnedLeadConfig {
     v("weights", weights);
     v("threshold", search.threshold, geometry::in(0.01, 0.99));
     v("window_half_px", search.window_half_px, geometry::in(16, 4096));
+  }
+};
+
+// frontend.motion_lead: the motion detector's background and blobs (vision/motion_lead_detector.hpp).
+struct MotionLeadConfig {
+  MotionLeadSettings search{};
+
+  template <class V>
+  void visit(V& v) {
+    v("downscale", search.downscale, geometry::in(1, 8));
+    v("step_px", search.step_px, geometry::in(1.0, 500.0));
+    v("references", search.references, geometry::in(3, 15));
+    v("history", search.history, geometry::in(3, 1000));
+    v("threshold", search.threshold, geometry::in(1.0, 254.0));
+    v("min_area_px", search.min_area_px, geometry::in(1.0, 1e6));
+    v("window_half_px", search.window_half_px, geometry::in(8, 4096));
   }
 };
 
@@ -44,6 +61,7 @@ struct FrontendSettings {
   std::string noise_model = "frontend/noise_model.yaml";
   LeadDetectorKind lead_detector = LeadDetectorKind::Auto;
   LearnedLeadConfig learned_lead{};
+  MotionLeadConfig motion_lead{};
 
   template <class V>
   void visit(V& v) {
@@ -51,8 +69,9 @@ struct FrontendSettings {
     v("noise_model", noise_model);
     v.choice("lead_detector", lead_detector,
              {{"auto", LeadDetectorKind::Auto}, {"aruco", LeadDetectorKind::Aruco}, {"panel", LeadDetectorKind::Panel},
-              {"learned", LeadDetectorKind::Learned}});
+              {"learned", LeadDetectorKind::Learned}, {"motion", LeadDetectorKind::Motion}});
     v.section("learned_lead", [&](auto& l) { learned_lead.visit(l); });
+    v.section("motion_lead", [&](auto& m) { motion_lead.visit(m); });
     v.section("tracking", [&](auto& t) { tracking.visit(t); });
     v.section("cross_matching", [&](auto& c) { cross_matching.visit(c); });
     v.section("active_search", [&](auto& a) { active_search.visit(a); });

@@ -65,6 +65,7 @@ std::unique_ptr<vision::LeadFinder> make_detector(const BenchLeadOptions& o, con
   const K kind = o.detector == "aruco"     ? K::Aruco
                  : o.detector == "panel"   ? K::Panel
                  : o.detector == "learned" ? K::Learned
+                 : o.detector == "motion"  ? K::Motion
                                            : lead_detector(cfg);
   vision::LearnedLeadSettings learned = cfg.frontend.learned_lead.search;
   if (o.threshold > 0) learned.threshold = o.threshold;
@@ -75,7 +76,10 @@ std::unique_ptr<vision::LeadFinder> make_detector(const BenchLeadOptions& o, con
                                                        "lead detector weights")
                                   : o.weights;
     }
-    name = kind == K::Learned ? "learned (" + weights + ")" : kind == K::Panel ? "panel" : "aruco";
+    name = kind == K::Learned  ? "learned (" + weights + ")"
+           : kind == K::Motion ? "motion"
+           : kind == K::Panel  ? "panel"
+                               : "aruco";
     return make_lead_finder(cfg, kind, weights, learned);
   } catch (const std::runtime_error& e) {  // not found, or vision::LeadModelError
     throw io::UsageError(fmt::format("--weights: {}", e.what()));
@@ -87,9 +91,7 @@ void bench_dataset(const BenchLeadOptions& o, const fs::path& dir, std::vector<f
                    std::string& detector_name, io::ProgressLine& progress) {
   const datasets::Dataset ds = datasets::read_dataset(dir);
   const RunConfig cfg = dataset_scenario(ds);
-  std::unique_ptr<vision::LeadFinder> detector;
-  if (o.detections.empty()) detector = make_detector(o, cfg, detector_name);
-  const bool colour = cfg.world.lead.cue == sim::LeadModelSpec::Cue::Panel && o.detector != "learned";
+  const bool colour = cfg.world.lead.cue == sim::LeadModelSpec::Cue::Panel && (o.detector == "auto" || o.detector == "panel");
   std::mt19937_64 rng(1);
   std::normal_distribution<double> noise(0.0, o.prediction_sigma);
   const std::string name = o.datasets.size() > 1 ? dir.filename().string() : "";
@@ -97,6 +99,9 @@ void bench_dataset(const BenchLeadOptions& o, const fs::path& dir, std::vector<f
   for (const auto& a : ds.agents) total += a.camera ? static_cast<int>(a.frames.size()) : 0;
   for (const auto& a : ds.agents) {
     if (!a.camera) continue;
+    // Each camera's own detector, given its frames in order (the motion detector keeps them).
+    std::unique_ptr<vision::LeadFinder> detector;
+    if (o.detections.empty()) detector = make_detector(o, cfg, detector_name);
     if (a.lead_labels.empty())
       throw io::UsageError(fmt::format("{}: agent {} has no cam0_lead0 (the lead's labels): render the dataset "
                                        "again with this wingman", dir.string(), a.name));
@@ -168,8 +173,8 @@ Subcommand add_bench_lead(CLI::App& parent) {
       "pixel error of x_h and CPU time, per lead, ground, distance and visible share");
   cmd->add_option("datasets", o->datasets, "Datasets written by `wingman render`")->required()->check(CLI::ExistingDirectory);
   cmd->add_option("--detector", o->detector, "auto (the scenario's: aruco, panel, or learned for cue: none), aruco, "
-                                             "panel or learned")
-      ->check(CLI::IsMember({"auto", "aruco", "panel", "learned"}));
+                                             "panel, learned or motion")
+      ->check(CLI::IsMember({"auto", "aruco", "panel", "learned", "motion"}));
   cmd->add_option("--weights", o->weights, "The learned detector's ONNX file (default: the scenario's)");
   cmd->add_option("--threshold", o->threshold, "The learned detector's peak threshold (default: the scenario's)")
       ->check(CLI::Range(0.01, 0.99));

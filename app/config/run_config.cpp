@@ -179,6 +179,14 @@ void resolve_lead_detector(RunConfig& cfg, const Provenance& prov) {
     fail_at(prov, cfg, key, "aruco finds the lead's marker: it needs world.lead.cue: aruco");
   if (kind == K::Panel && cfg.world.lead.cue != Cue::Panel)
     fail_at(prov, cfg, key, "panel finds the lead's colour panel: it needs world.lead.cue: panel");
+  if (kind == K::Motion) {
+    try {
+      cfg.frontend.motion_lead.search.validate();
+    } catch (const std::invalid_argument& e) {
+      const sim::Loc* at = prov.find("frontend", "motion_lead.history");
+      fail_at(prov, cfg, at ? at : prov.find("frontend", "motion_lead.references"), e.what());
+    }
+  }
   if (kind != K::Learned || cfg.measurements != sim::MeasurementMode::Rendered) return;
   const sim::Loc* weights = prov.find("frontend", "learned_lead.weights");
   try {

@@ -26,6 +26,7 @@ std::unique_ptr<vision::LeadFinder> make_lead_finder(const RunConfig& cfg, visio
                                                      const vision::LearnedLeadSettings& learned) {
   using K = vision::LeadDetectorKind;
   if (kind == K::Auto) kind = lead_detector(cfg);
+  if (kind == K::Motion) return std::make_unique<vision::MotionLeadDetector>(cfg.frontend.motion_lead.search);
   if (kind == K::Learned) {
     if (weights.empty()) throw std::invalid_argument(cfg.source_path + ": the learned lead detector has no weights file");
     return std::make_unique<vision::LearnedLeadDetector>(weights, learned);
@@ -52,7 +53,6 @@ VisionFrontend::VisionFrontend(const RunConfig& cfg, const std::vector<int>& cam
                                const std::optional<vision::FeatureSettings>& features)
     : cfg_(cfg),
       features_(features ? *features : cfg.frontend.features),
-      lead_(make_lead_finder(cfg, lead_detector(cfg), cfg.lead_weights_path, cfg.frontend.learned_lead.search)),
       tracking_(cfg.frontend.tracking),
       cross_(cross_match_settings(cfg)) {
   tracking_.validate();
@@ -60,6 +60,7 @@ VisionFrontend::VisionFrontend(const RunConfig& cfg, const std::vector<int>& cam
   for (int u : cam_uav) {
     Cam c;
     c.model = cfg.uavs[u].camera.camera();
+    c.lead_finder = make_lead_finder(cfg, lead_detector(cfg), cfg.lead_weights_path, cfg.frontend.learned_lead.search);
     cams_.push_back(std::move(c));
   }
 }
@@ -75,7 +76,7 @@ double VisionFrontend::detect(int cam, const render::Frame& frame, const slam::E
   const cv::Mat grey = frame.gray();
   cv::Mat bgr;
   if (colour_lead_) cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
-  const auto det = lead_->detect(colour_lead_ ? bgr : grey, predicted);
+  const auto det = c.lead_finder->detect(colour_lead_ ? bgr : grey, predicted);
   c.lead.reset();
   std::vector<vision::ExclusionBox> exclude;
   if (det) {

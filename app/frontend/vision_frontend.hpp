@@ -18,6 +18,7 @@
 #include "vision/descriptor_store.hpp"
 #include "vision/features.hpp"
 #include "vision/lead_detector.hpp"
+#include "vision/motion_lead_detector.hpp"
 #include "vision/tracking.hpp"
 
 namespace wingman::app {
@@ -26,9 +27,9 @@ namespace wingman::app {
 // the estimator's initialisation (validated).
 vision::CrossMatchSettings cross_match_settings(const RunConfig& cfg);
 
-// The lead detector of `kind` (auto: lead_detector(cfg)) with the scenario's marker id, or the
-// learned one from `weights` with `learned`'s search; throws vision::LeadModelError for weights that
-// do not load.
+// The lead detector of `kind` (auto: lead_detector(cfg)) with the scenario's marker id, the
+// learned one from `weights` with `learned`'s search, or the motion detector with the scenario's
+// frontend.motion_lead; throws vision::LeadModelError for weights that do not load. One per camera.
 std::unique_ptr<vision::LeadFinder> make_lead_finder(const RunConfig& cfg, vision::LeadDetectorKind kind,
                                                      const std::string& weights,
                                                      const vision::LearnedLeadSettings& learned);
@@ -88,6 +89,7 @@ class VisionFrontend {
     vision::Features features;
     std::vector<vision::LandmarkPrediction> preds;  // this step's, for free features and spread
     std::vector<bool> used;                         // keypoints taken by tracking or matching
+    std::unique_ptr<vision::LeadFinder> lead_finder;  // its own: a finder may keep earlier frames
     std::optional<Eigen::Vector2d> lead;
     Marks marks;
     double searched = 1.0;
@@ -99,7 +101,6 @@ class VisionFrontend {
                                      const slam::Estimator& est) const;
   const RunConfig& cfg_;
   vision::FeatureExtractor features_;
-  std::unique_ptr<vision::LeadFinder> lead_;
   vision::TrackingSettings tracking_;
   vision::CrossMatchSettings cross_;
   vision::DescriptorStore store_;

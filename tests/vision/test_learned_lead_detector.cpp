@@ -44,7 +44,7 @@ TEST(LearnedLeadDetector, ANetworkWithTheWrongOutputShapeIsRefusedNamingIt) {
 }
 
 TEST(LearnedLeadDetector, TheShippedNetworkLoadsAndFindsNothingOnAFlatImage) {
-  const LearnedLeadDetector d((kSource / "assets" / "lead" / "lead_detector.onnx").string());
+  LearnedLeadDetector d((kSource / "assets" / "lead" / "lead_detector.onnx").string());
   EXPECT_FALSE(d.detect(cv::Mat(480, 640, CV_8UC1, cv::Scalar(90))).has_value());
   EXPECT_FALSE(d.detect(cv::Mat(480, 640, CV_8UC1, cv::Scalar(90)), Eigen::Vector2d(300, 200)).has_value());
 }

@@ -1,7 +1,8 @@
 // `wingman bench-lead`: the learned detector scored on a rendered dataset of an unmarked truck; the
-// detections it writes score the same when read back; bad input (a malformed detections row, a
-// missing weights file, a detector the world's cue cannot serve) exits 2 naming the file and line
-// with nothing written.
+// detections it writes score the same when read back; the motion detector runs in a flight and in
+// the benchmark; bad input (a malformed detections row, a missing weights file, a detector the
+// world's cue cannot serve, motion settings that contradict each other) exits 2 naming the file
+// and line with nothing written.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -82,6 +83,27 @@ TEST(BenchLeadCli, BadInputExitsTwoNamingTheFileWithNothingWritten) {
   EXPECT_THAT(r.output, ::testing::HasSubstr("w.yaml:9:36: frontend.learned_lead.weights: lead detector weights 'missing.onnx': file not found"));
   EXPECT_THAT(r.output, ::testing::HasSubstr("missing.onnx"));
   EXPECT_FALSE(fs::exists(tmp / "o4"));
+
+  write_file(tmp / "m.yaml", unmarked_truck("frontend: {lead_detector: motion, motion_lead: {references: 6, history: 5}}\n"));
+  r = run_wingman({"run", (tmp / "m.yaml").string(), "--out", (tmp / "o5").string()}, tmp.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, ::testing::HasSubstr("m.yaml:9:73: frontend.motion_lead.history: motion lead detector: "
+                                             "history must be >= references, got 5"));
+  EXPECT_FALSE(fs::exists(tmp / "o5"));
+}
+
+TEST(BenchLeadCli, TheMotionDetectorRunsInAFlightAndInTheBenchmark) {
+  TempDir tmp;
+  write_file(tmp / "s.yaml", unmarked_truck("frontend: {lead_detector: motion}\n"));
+  const auto r = run_wingman({"run", (tmp / "s.yaml").string(), "--out", (tmp / "run").string(), "-q", "--no-plots"},
+                             tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(tmp / "run" / "lead.csv"));
+  const fs::path ds = tmp / "ds";
+  ASSERT_EQ(run_wingman({"render", (tmp / "s.yaml").string(), "--out", ds.string(), "-q"}, tmp.path()).exit_code, 0);
+  const auto b = run_wingman({"bench-lead", ds.string(), "--quiet"}, tmp.path());
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_THAT(b.output, ::testing::HasSubstr("Lead detector: motion"));
 }
 
 }  // namespace

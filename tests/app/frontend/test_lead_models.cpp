@@ -30,7 +30,7 @@ TEST_P(LeadModelTest, CueIsDetectedAtTheReferencePointFromEveryUav) {
   const RunConfig scn = load_run_configs((kSourceDir / "scenes" / GetParam()).string()).front();
   const sim::OpenLoopTruth truth(scn);
   render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
-  const vision::LeadDetector detector;  // the frontend's default: DICT_4X4_50, id 0
+  vision::LeadDetector detector;  // the frontend's default: DICT_4X4_50, id 0
   for (double t : {0.0, 11.3, 27.9}) {
     const sim::LeadPose lead = sim::lead_pose(truth, t, scn.world);
     for (int j = 0; j < static_cast<int>(scn.uavs.size()); ++j) {
