@@ -79,6 +79,14 @@ Eigen::Vector2d diagonal_intersection(const std::array<Eigen::Vector2d, 4>& c) {
   return c[0] + st(0) * (c[2] - c[0]);
 }
 
+cv::Mat lead_search_grey(const cv::Mat& image, const std::string& who) {
+  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    throw std::invalid_argument(who + ": expected an 8-bit grey or BGR image");
+  cv::Mat grey = image;
+  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
 ExclusionBox exclusion_box(const LeadDetection& d, double scale, double min_half_px) {
   const double h = std::max(min_half_px, scale * d.size_px);
   return ExclusionBox{d.uv, h, h};

@@ -94,6 +94,9 @@ class LeadDetector final : public LeadFinder {
   int dictionary_ = 0;
 };
 
+// `image` (8-bit grey, or BGR) as grey; throws std::invalid_argument naming `who` for any other.
+cv::Mat lead_search_grey(const cv::Mat& image, const std::string& who);
+
 // A box around a detection to keep out of the map features (features.hpp), `scale` times the
 // detection's size on each side of the centre, at least min_half_px.
 ExclusionBox exclusion_box(const LeadDetection& d, double scale = 1.5, double min_half_px = 20);

@@ -73,10 +73,7 @@ std::pair<double, Eigen::Vector2d> LearnedLeadDetector::peak(const cv::Mat& grey
 
 std::optional<LeadDetection> LearnedLeadDetector::detect(const cv::Mat& image,
                                                          const std::optional<Eigen::Vector2d>& predicted) {
-  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
-    throw std::invalid_argument("LearnedLeadDetector::detect: expected an 8-bit grey or BGR image");
-  cv::Mat grey = image;
-  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  cv::Mat grey = lead_search_grey(image, "LearnedLeadDetector::detect");
   // Regions a multiple of the stride in size, inside the image.
   auto fit = [&](cv::Rect r) {
     r &= cv::Rect(0, 0, grey.cols, grey.rows);

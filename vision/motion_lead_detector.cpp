@@ -173,10 +173,7 @@ std::optional<LeadDetection> MotionLeadDetector::blob(const std::optional<Eigen:
 
 std::optional<LeadDetection> MotionLeadDetector::detect(const cv::Mat& image,
                                                         const std::optional<Eigen::Vector2d>& predicted) {
-  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
-    throw std::invalid_argument("MotionLeadDetector::detect: expected an 8-bit grey or BGR image");
-  cv::Mat grey = image;
-  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  cv::Mat grey = lead_search_grey(image, "MotionLeadDetector::detect");
   if (cfg_.downscale > 1) cv::resize(grey, grey, grey.size() / cfg_.downscale, 0, 0, cv::INTER_AREA);
   mask_ = cv::Mat(grey.size(), CV_8U, cv::Scalar(0));
   cv::Mat H;
