@@ -76,7 +76,7 @@ VisualUpdateResult Estimator::update_visual(
     const std::vector<std::pair<int, Eigen::Vector2d>>& lead_pixels) {
   std::vector<Measurement> lead;
   for (const auto& [cam, uv] : lead_pixels)
-    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.measurement_noise.pixel_sigma.value))
+    if (auto m = lead_projection_measurement(s_, cam, cams_[cam], uv, cfg_.measurement_noise.lead_sigma()))
       lead.push_back(std::move(*m));
   for (const auto& m : lead) check_measurement(m, fmt::format("the lead's pixel in camera {}", m.camera));
   for (const auto& c : candidates)

@@ -54,6 +54,14 @@ struct MeasurementNoiseSettings {
   // runs take sqrt(2) noise.pixel_bias_sigma (the difference of two cameras' offsets), rendered
   // runs the frontend noise model's.
   geometry::AutoNumber pixel_offset_sigma{0.0};
+  // px, per axis, of the lead's pixel (x_h's projection). `auto`: pixel_sigma for a marker or a
+  // panel (and in synthetic runs, where it stays `auto`); a marker-free detector's own figure
+  // (frontend.learned_lead.pixel_sigma, frontend.motion_lead.pixel_sigma).
+  geometry::AutoNumber lead_pixel_sigma{0.0};
+  // The lead's sigma in use: pixel_sigma while lead_pixel_sigma is an `auto` no run resolved.
+  double lead_sigma() const {
+    return lead_pixel_sigma.automatic && lead_pixel_sigma.source.empty() ? pixel_sigma.value : lead_pixel_sigma.value;
+  }
   double gps_sigma = 1.5, altimeter_sigma = 0.5, range_sigma = 0.5;  // m
   // Gimbal pointing error about the camera's x and y axes (rad). 0.028 is the rms of the paper
   // scenes' truth error 0.04 sin(0.3 t); 0 trusts R_CW exactly.
@@ -70,6 +78,7 @@ struct MeasurementNoiseSettings {
     // are > 0 (the truth's may be 0, a perfect sensor).
     v("pixel_sigma", pixel_sigma, in(0, 1000, true));
     v("pixel_offset_sigma", pixel_offset_sigma, in(0, 1000));
+    v("lead_pixel_sigma", lead_pixel_sigma, in(0, 1000, true));
     v("gps_sigma", gps_sigma, in(0, 1e4, true));
     v("altimeter_sigma", altimeter_sigma, in(0, 1e4, true));
     v("range_sigma", range_sigma, in(0, 1e4, true));

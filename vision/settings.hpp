@@ -20,10 +20,16 @@ struct LearnedLeadConfig {
   // The ONNX file (tools/train_lead_detector.py): next to the scenario, then in assets/.
   std::string weights = "lead/lead_detector.onnx";
   LearnedLeadSettings search{};
+  // The error of x_h the filter assumes for it (px per axis, estimator.measurement_noise.
+  // lead_pixel_sigma: auto): about its p95 on held-out frames (0.75-1.42 px), since its error stays
+  // from frame to frame while the lead's look does, and a filter that takes it for white noise
+  // trusts it too much.
+  double pixel_sigma = 1.5;
 
   template <class V>
   void visit(V& v) {
     v("weights", weights);
+    v("pixel_sigma", pixel_sigma, geometry::in(0.01, 1000.0));
     v("threshold", search.threshold, geometry::in(0.01, 0.99));
     v("window_half_px", search.window_half_px, geometry::in(16, 4096));
   }
@@ -32,9 +38,13 @@ struct LearnedLeadConfig {
 // frontend.motion_lead: the motion detector's background and blobs (vision/motion_lead_detector.hpp).
 struct MotionLeadConfig {
   MotionLeadSettings search{};
+  // The error the filter assumes (px per axis): the silhouette's centroid lies about 10 px from
+  // a person's x_h.
+  double pixel_sigma = 10;
 
   template <class V>
   void visit(V& v) {
+    v("pixel_sigma", pixel_sigma, geometry::in(0.01, 1000.0));
     v("downscale", search.downscale, geometry::in(1, 8));
     v("step_px", search.step_px, geometry::in(1.0, 500.0));
     v("references", search.references, geometry::in(3, 15));

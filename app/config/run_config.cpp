@@ -121,6 +121,15 @@ void derive_noise(RunConfig& cfg, const Provenance& prov) {
   } catch (const std::invalid_argument& e) {
     fail_at(prov, cfg, prov.find("frontend", "detector"), e.what());
   }
+  // The lead's pixel: a marker-free detector states its own error; a marker's or a panel's stays
+  // `auto`, which is pixel_sigma (MeasurementNoiseSettings::lead_sigma).
+  auto& lead = cfg.estimator.measurement_noise.lead_pixel_sigma;
+  using K = vision::LeadDetectorKind;
+  if (cfg.measurements != sim::MeasurementMode::Rendered) return;
+  if (lead_detector(cfg) == K::Learned)
+    lead.derive(cfg.frontend.learned_lead.pixel_sigma, "auto: frontend.learned_lead.pixel_sigma");
+  else if (lead_detector(cfg) == K::Motion)
+    lead.derive(cfg.frontend.motion_lead.pixel_sigma, "auto: frontend.motion_lead.pixel_sigma");
 }
 
 // Whether some camera in the filter (or the lead, for the GPS) carries the sensor.

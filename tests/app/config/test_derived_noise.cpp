@@ -1,6 +1,7 @@
 // The estimator's noise a scenario leaves `auto` (app/config/derived_noise.hpp): process noise from the
-// path flown, pixel noise from the truth's noise or the frontend noise model, printed with its
-// origin in the resolved configuration; and the bad inputs around them.
+// path flown, pixel noise from the truth's noise or the frontend noise model, the lead's pixel noise
+// from its detector, printed with its origin in the resolved configuration; and the bad inputs
+// around them.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -101,6 +102,27 @@ TEST(DerivedNoise, RenderedPixelNoiseComesFromTheShippedModel) {
   EXPECT_DOUBLE_EQ(c.estimator.measurement_noise.pixel_sigma, m.orb.pixel_sigma);
   EXPECT_DOUBLE_EQ(c.estimator.measurement_noise.pixel_offset_sigma, m.orb.pixel_offset_sigma);
   EXPECT_NE(c.estimator.measurement_noise.pixel_sigma.source.find("detector orb"), std::string::npos);
+}
+
+TEST(DerivedNoise, TheLeadsPixelNoiseIsTheMarkersPixelSigmaOrAMarkerFreeDetectorsOwn) {
+  const auto noise = [](const std::string& yaml) {
+    return parse_run_configs("measurements: rendered\n" + yaml, "scn.yaml").front().estimator.measurement_noise;
+  };
+  const auto marked = noise("");
+  EXPECT_TRUE(marked.lead_pixel_sigma.automatic);
+  EXPECT_TRUE(marked.lead_pixel_sigma.source.empty());  // stays auto: pixel_sigma
+  EXPECT_DOUBLE_EQ(marked.lead_sigma(), marked.pixel_sigma.value);
+
+  const auto learned = noise("world: {lead: {cue: none}}\n");
+  EXPECT_DOUBLE_EQ(learned.lead_sigma(), 1.5);
+  EXPECT_EQ(learned.lead_pixel_sigma.source, "auto: frontend.learned_lead.pixel_sigma");
+  EXPECT_DOUBLE_EQ(noise("world: {lead: {cue: none}}\nfrontend: {learned_lead: {pixel_sigma: 0.8}}\n").lead_sigma(), 0.8);
+  EXPECT_DOUBLE_EQ(noise("world: {lead: {cue: none}}\nfrontend: {lead_detector: motion}\n").lead_sigma(), 10.0);
+  EXPECT_DOUBLE_EQ(noise("world: {lead: {cue: none}}\nestimator: {measurement_noise: {lead_pixel_sigma: 2.5}}\n")
+                       .lead_sigma(),
+                   2.5);
+  const auto synthetic = parse_run_configs("world: {lead: {cue: none}}\n", "scn.yaml").front().estimator.measurement_noise;
+  EXPECT_DOUBLE_EQ(synthetic.lead_sigma(), synthetic.pixel_sigma.value);
 }
 
 TEST(DerivedNoise, AnEstimatorSigmaOfZeroIsRefusedAtItsKey) {
