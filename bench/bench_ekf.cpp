@@ -22,6 +22,7 @@
 #include <optional>
 #include <random>
 #include <stdexcept>
+#include <tuple>
 #include <vector>
 
 #include "geometry/camera.hpp"
@@ -77,23 +78,37 @@ std::optional<Vector2d> pixel(const slam::CameraRig& rig, const Vector3d& cam, c
   return uv;
 }
 
-Prepared prepare(int n_landmarks) {
+// Camera j of a team: pairs like the paper's two (x -1.5 and 1.5, 15 and 17 m up), the first at
+// y 0 and the others 3 m, -3 m, 6 m ... beside it.
+std::vector<Vector3d> team(int n) {
+  std::vector<Vector3d> out;
+  for (int j = 0; j < n; ++j) {
+    const int k = j / 2;
+    const double y = 3.0 * ((k + 1) / 2) * (k % 2 ? 1 : -1);
+    out.emplace_back(j % 2 ? 1.5 : -1.5, y, j % 2 ? 17 : 15);
+  }
+  return out;
+}
+
+Prepared prepare(int n_landmarks, int n_cameras = 2, bool offsets = false) {
   Prepared out;
-  out.cam_truth = {Vector3d(-1.5, 0, 15), Vector3d(1.5, 0, 17)};
+  out.cam_truth = team(n_cameras);
   slam::EstimatorSettings cfg;
   cfg.process_noise.accel_sigma_lead = 0.1;  // white, per agent
   cfg.process_noise.accel_sigma_uav = 0.5;
   cfg.process_noise.accel_sigma_common = 0.0;
   cfg.measurement_noise.orientation_sigma = 0;
+  // With offsets, each landmark carries the other cameras' pixel offsets (as the rendered scenes).
+  cfg.measurement_noise.pixel_offset_sigma = offsets ? 0.75 : 0.0;
   cfg.gating.ransac_inlier_px = 4;
   cfg.map.max_landmarks = n_landmarks;
   cfg.map.max_misses = 1 << 30;                 // nothing is dropped for missing matches
   cfg.initialisation.min_parallax_deg = 1.0;  // the far, out-of-view part of the grid
   cfg.initialisation.low_parallax_inverse_depth = false;
-  const auto nadir_rig = nadir_rigs(2);
+  const auto nadir_rig = nadir_rigs(n_cameras);
   auto rigs = nadir_rig;
-  const std::vector<slam::AgentInit> cams = {{out.cam_truth[0], Vector3d::Zero()},
-                                             {out.cam_truth[1], Vector3d::Zero()}};
+  std::vector<slam::AgentInit> cams;
+  for (const Vector3d& c : out.cam_truth) cams.push_back({c, Vector3d::Zero()});
   out.est = std::make_unique<slam::Estimator>(rigs, slam::AgentInit{}, cams, cfg);
   slam::Estimator& est = *out.est;
 
@@ -117,7 +132,7 @@ Prepared prepare(int n_landmarks) {
     const bool in_view =
         pixel(nadir_rig[0], out.cam_truth[0], p) && pixel(nadir_rig[1], out.cam_truth[1], p);
     const Eigen::Matrix3d R = in_view ? nadir() : look_at(mid, p);
-    for (int j = 0; j < 2; ++j) {
+    for (int j = 0; j < n_cameras; ++j) {
       est.set_camera_rotation(j, R);
       rigs[j].R_CW = R;
     }
@@ -126,7 +141,7 @@ Prepared prepare(int n_landmarks) {
     const auto r = est.initialise_from_matches({{0, 1, *uv_a, *uv_b}});
     if (r[0].id) out.truth[*r[0].id] = p;
   }
-  for (int j = 0; j < 2; ++j) est.set_camera_rotation(j, nadir());
+  for (int j = 0; j < n_cameras; ++j) est.set_camera_rotation(j, nadir());
   est.end_step();
   if (est.num_landmarks() != n_landmarks) throw std::logic_error("bench_ekf: wrong landmark count");
 
@@ -142,16 +157,17 @@ Prepared prepare(int n_landmarks) {
 }
 
 // Built once per size: Google Benchmark calls the function more than once per argument.
-const Prepared& prepared(int n) {
-  static std::map<int, Prepared> cache;
-  auto it = cache.find(n);
-  if (it == cache.end()) it = cache.emplace(n, prepare(n)).first;
+const Prepared& prepared(int n, int cameras, bool offsets) {
+  static std::map<std::tuple<int, int, bool>, Prepared> cache;
+  const auto key = std::make_tuple(n, cameras, offsets);
+  auto it = cache.find(key);
+  if (it == cache.end()) it = cache.emplace(key, prepare(n, cameras, offsets)).first;
   return it->second;
 }
 
-void BM_EkfStep(benchmark::State& state) {
-  const int n = static_cast<int>(state.range(0));
-  const Prepared& prep = prepared(n);
+// One step of a team of `cameras` cameras over an `n`-landmark map.
+void ekf_step(benchmark::State& state, int n, int cameras, bool offsets = false) {
+  const Prepared& prep = prepared(n, cameras, offsets);
   std::mt19937_64 rng(42);
   std::normal_distribution<double> noise(0.0, kPixelSigma);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -173,7 +189,7 @@ void BM_EkfStep(benchmark::State& state) {
 
     est.predict(0.1);
     std::vector<slam::Correspondence> cands;
-    for (int j = 0; j < 2; ++j) {
+    for (int j = 0; j < cameras; ++j) {
       const auto preds = est.landmarks_in_view(j);
       visible += preds.size();
       // At most kMaxPerCamera, spread over the predictions.
@@ -213,6 +229,16 @@ void BM_EkfStep(benchmark::State& state) {
   state.counters["evicted"] = benchmark::Counter(evicted, avg);
 }
 
+void BM_EkfStep(benchmark::State& state) { ekf_step(state, static_cast<int>(state.range(0)), 2); }
+
+// The team-size axis: 2 to 8 cameras over the same 200-landmark map (each camera offers at most 40
+// correspondences), with white pixel noise (offsets 0) or with the other cameras' pixel offsets as
+// states of every landmark (offsets 1). A single UAV has no cooperative initialisation:
+// docs/studies/team-size.md.
+void BM_EkfTeam(benchmark::State& state) {
+  ekf_step(state, 200, static_cast<int>(state.range(0)), state.range(1) != 0);
+}
+
 BENCHMARK(BM_EkfStep)
     ->ArgName("landmarks")
     ->Arg(50)
@@ -223,6 +249,11 @@ BENCHMARK(BM_EkfStep)
     ->MinTime(0.2);
 // A step takes about 0.3 s here: a longer minimum for more than one iteration.
 BENCHMARK(BM_EkfStep)->ArgName("landmarks")->Arg(800)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_EkfTeam)
+    ->ArgNames({"cameras", "offsets"})
+    ->ArgsProduct({{2, 4, 6, 8}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
 
 }  // namespace
 
