@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "geometry/camera.hpp"
+#include "io/heap.hpp"
 #include "slam/estimator.hpp"
 
 namespace {
@@ -257,4 +258,12 @@ BENCHMARK(BM_EkfTeam)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// The wingman command's heap policy (io/heap.hpp), so that a step costs here what it costs there.
+int main(int argc, char** argv) {
+  wingman::io::keep_freed_memory_on_the_heap();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,6 +1,7 @@
 #include "slam/ekf_update.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 
 namespace wingman::slam {
 
@@ -31,51 +32,127 @@ Eigen::VectorXd single_measurement_correction(const FilterState& s, const Measur
   return PHt * w;
 }
 
-bool ekf_update(FilterState& s, const std::vector<const Measurement*>& ms) {
-  int rows = 0;
-  for (const auto* m : ms) rows += m->dim();
-  if (rows == 0) return true;
-  const int n = s.dim();
+namespace {
+// The measurements in groups whose noises are independent of each other's: one group per camera
+// (its projections share the gimbal's pointing error, eq. 45) and one for the rest, in the order
+// they first appear.
+std::vector<std::vector<const Measurement*>> independent_blocks(const std::vector<const Measurement*>& ms) {
+  std::vector<int> keys;
+  std::vector<std::vector<const Measurement*>> out;
+  for (const auto* m : ms) {
+    const int key = std::max(m->camera, -1);
+    auto it = std::find(keys.begin(), keys.end(), key);
+    if (it == keys.end()) {
+      keys.push_back(key);
+      out.emplace_back();
+      it = keys.end() - 1;
+    }
+    out[it - keys.begin()].push_back(m);
+  }
+  return out;
+}
 
-  Eigen::MatrixXd PHt = Eigen::MatrixXd::Zero(n, rows);
+// out += P(:, col..) H^T with P read from its lower triangle only (the upper one is stale between
+// blocks): column c of P is P(c, 0:c)^T above the diagonal and P(c:n, c) from it down.
+void add_symmetric_columns_times(const Eigen::MatrixXd& P, int col, const SmallMat& H,
+                                 Eigen::Ref<Eigen::MatrixXd> out) {
+  const int n = static_cast<int>(P.rows());
+  for (int k = 0; k < H.cols(); ++k) {
+    const int c = col + k;
+    out.topRows(c).noalias() += P.row(c).head(c).transpose() * H.col(k).transpose();
+    out.bottomRows(n - c).noalias() += P.col(c).tail(n - c) * H.col(k).transpose();
+  }
+}
+
+// Copies P's strictly lower triangle onto the upper one (to_upper) or the upper onto the lower,
+// in square tiles so that both sides are read and written a cache line at a time.
+void mirror_triangle(Eigen::MatrixXd& P, bool to_upper) {
+  constexpr int kTile = 64;
+  const int n = static_cast<int>(P.rows());
+  for (int j0 = 0; j0 < n; j0 += kTile)
+    for (int i0 = j0; i0 < n; i0 += kTile) {  // the tile at rows i0, columns j0 of the lower triangle
+      const int h = std::min(kTile, n - i0), w = std::min(kTile, n - j0);
+      if (i0 != j0) {
+        if (to_upper) P.block(j0, i0, w, h) = P.block(i0, j0, h, w).transpose();
+        else P.block(i0, j0, h, w) = P.block(j0, i0, w, h).transpose();
+        continue;
+      }
+      for (int c = 0; c < w; ++c)
+        for (int r = c + 1; r < h; ++r) {
+          if (to_upper) P(j0 + c, i0 + r) = P(i0 + r, j0 + c);
+          else P(i0 + r, j0 + c) = P(j0 + c, i0 + r);
+        }
+    }
+}
+
+// One block's correction, its Jacobians taken at the prior x0: the innovation is moved by what
+// the earlier blocks corrected (y - H (x - x0)), so that the blocks in turn give the joint
+// posterior of eq. 43-45 up to rounding. Only P's lower triangle (diagonal included) is read and
+// written. W: n x rows of workspace.
+bool block_update(FilterState& s, const std::vector<const Measurement*>& ms, const Eigen::VectorXd& x0,
+                  Eigen::Ref<Eigen::MatrixXd> W) {
+  const int rows = static_cast<int>(W.cols());
+  W.setZero();  // P H^T first, then W = P H^T L^-T in place
   Eigen::VectorXd y(rows);
+  const Eigen::VectorXd dx = s.x - x0;
   int r = 0;
   for (const auto* m : ms) {
-    for (const auto& b : m->blocks)
-      PHt.middleCols(r, m->dim()).noalias() += s.P.middleCols(b.col, b.H.cols()) * b.H.transpose();
     y.segment(r, m->dim()) = m->innovation();
+    for (const auto& b : m->blocks) {
+      add_symmetric_columns_times(s.P, b.col, b.H, W.middleCols(r, m->dim()));
+      y.segment(r, m->dim()).noalias() -= b.H * dx.segment(b.col, b.H.cols());
+    }
     r += m->dim();
   }
-  // S = H (P H^T) + R, row block by row block.
+  // S = H (P H^T) + R + V V^T sigma^2: the shared gimbal noise correlates every pair of
+  // projections of one camera (eq. 45), and a block holds one camera's.
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(rows, rows);
   r = 0;
-  for (const auto* m : ms) {
-    for (const auto& b : m->blocks)
-      S.middleRows(r, m->dim()).noalias() += b.H * PHt.middleRows(b.col, b.H.cols());
-    S.block(r, r, m->dim(), m->dim()) += m->R;
-    r += m->dim();
-  }
-  // Shared gimbal noise: every pair of projections of one camera is correlated through it.
-  std::vector<int> offsets;
-  r = 0;
-  for (const auto* m : ms) offsets.push_back(r), r += m->dim();
-  for (size_t a = 0; a < ms.size(); ++a) {
-    if (ms[a]->camera < 0) continue;
-    for (size_t b = 0; b < ms.size(); ++b)
-      if (ms[b]->camera == ms[a]->camera)
-        S.block(offsets[a], offsets[b], ms[a]->dim(), ms[b]->dim()).noalias() +=
-            ms[a]->orientation_sigma * ms[a]->orientation_sigma * ms[a]->V * ms[b]->V.transpose();
+  for (const auto* a : ms) {
+    for (const auto& b : a->blocks) S.middleRows(r, a->dim()).noalias() += b.H * W.middleRows(b.col, b.H.cols());
+    S.block(r, r, a->dim(), a->dim()) += a->R;
+    if (a->camera >= 0) {
+      int c = 0;
+      for (const auto* b : ms) {
+        S.block(r, c, a->dim(), b->dim()).noalias() +=
+            a->orientation_sigma * a->orientation_sigma * a->V * b->V.transpose();
+        c += b->dim();
+      }
+    }
+    r += a->dim();
   }
   S = 0.5 * (S + S.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(S);
   if (llt.info() != Eigen::Success) return false;
-
-  // W^T = L^-1 (P H^T)^T, so K y = W L^-1 y and K S K^T = W W^T.
-  const Eigen::MatrixXd Wt = llt.matrixL().solve(PHt.transpose());
+  // W = P H^T L^-T (S = L L^T), so K y = W L^-1 y and K S K^T = W W^T.
+  llt.matrixU().solveInPlace<Eigen::OnTheRight>(W);
   const Eigen::VectorXd v = llt.matrixL().solve(y);
-  s.x.noalias() += Wt.transpose() * v;                                    // eq. 43
-  s.P.selfadjointView<Eigen::Lower>().rankUpdate(Wt.transpose(), -1.0);  // eq. 44
-  for (int c = 0; c < n; ++c) s.P.row(c).tail(n - c - 1) = s.P.col(c).tail(n - c - 1).transpose();
+  s.x.noalias() += W * v;                                    // eq. 43
+  s.P.selfadjointView<Eigen::Lower>().rankUpdate(W, -1.0);  // eq. 44
+  return true;
+}
+}  // namespace
+
+bool ekf_update(FilterState& s, const std::vector<const Measurement*>& ms) {
+  if (ms.empty()) return true;
+  const auto blocks = independent_blocks(ms);
+  const int n = s.dim();
+  const Eigen::VectorXd x0 = s.x;
+  // The blocks write the lower triangle only: the upper one and this diagonal restore P on failure.
+  const Eigen::VectorXd diagonal0 = s.P.diagonal();
+  // Workspace kept between calls: a new n x rows matrix at every update costs page faults.
+  static thread_local std::vector<double> workspace;
+  for (const auto& b : blocks) {
+    int rows = 0;
+    for (const auto* m : b) rows += m->dim();
+    if (workspace.size() < static_cast<std::size_t>(n) * rows) workspace.resize(static_cast<std::size_t>(n) * rows);
+    if (block_update(s, b, x0, Eigen::Map<Eigen::MatrixXd>(workspace.data(), n, rows))) continue;
+    s.x = x0;
+    s.P.diagonal() = diagonal0;
+    mirror_triangle(s.P, false);
+    return false;
+  }
+  mirror_triangle(s.P, true);
   return true;
 }
 

@@ -1,7 +1,11 @@
 // EKF correction (paper eq. 43-45) for a batch of measurements whose Jacobians are a few dense
-// blocks each. P H^T is built block by block (O(n m) instead of O(n^2 m)), and the covariance
-// update P -= W W^T with W = P H^T L^-T (S = L L^T) is a symmetric rank-m update that keeps P
-// exactly symmetric.
+// blocks each. The batch is processed in independent blocks, one per camera (its projections
+// share the gimbal's noise) and one for the other sensors, each linearised at the prior, so the
+// result is the joint update up to rounding while no innovation covariance larger than one
+// camera's is factorised: O(n^2 m + n sum m_i^2 + sum m_i^3) for n states, m rows, m_i per
+// block, against O(n^2 m + n m^2 + m^3) jointly. P H^T is built Jacobian block by Jacobian
+// block (O(n m)), and the covariance update P -= W W^T with W = P H^T L^-T (S = L L^T) is a
+// symmetric rank-m_i update that keeps P exactly symmetric.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,8 +25,8 @@ double mahalanobis_squared(const Measurement& m, const SmallSq& S);
 // State correction K y of one measurement, without touching P (1-point RANSAC hypotheses).
 Eigen::VectorXd single_measurement_correction(const FilterState& s, const Measurement& m);
 
-// Joint update with every measurement given (eq. 43-45). Returns false, leaving the state
-// unchanged, when the innovation covariance is not positive definite.
+// Update with every measurement given (eq. 43-45). Returns false, leaving the state unchanged,
+// when a block's innovation covariance is not positive definite.
 bool ekf_update(FilterState& s, const std::vector<const Measurement*>& ms);
 
 }  // namespace wingman::slam

@@ -136,24 +136,30 @@ TEST(Prediction, CommonAccelerationIsSingerForEveryAgent) {
   EXPECT_EQ((none.P - before.P).norm(), 0.0);
 }
 
-TEST(Update, SparseUpdateEqualsDenseKalmanUpdate) {
+// The update processes one camera's projections at a time (they share the gimbal's noise) and
+// the other sensors as one more block, each linearised at the prior: the result is the joint
+// Kalman update of eq. 43-45 over all of them, with the gimbal noise correlating each camera's.
+TEST(Update, PerCameraBlocksEqualTheDenseJointKalmanUpdate) {
+  for (const double orientation_sigma : {0.0, 0.02}) {
+  SCOPED_TRACE("orientation sigma " + std::to_string(orientation_sigma));
   std::mt19937_64 rng(5);
   FilterState s = two_camera_state_with_landmarks(6, rng);
   const FilterState before = s;
-  const CameraRig rig = nadir_rig();
+  CameraRig rig = nadir_rig();
+  rig.orientation_sigma = orientation_sigma;
   std::vector<Measurement> ms;
-  for (int i = 0; i < 4; ++i) {
+  ms.push_back(gps_measurement(s, Eigen::Vector3d(0.5, -0.3, 0.2), 1.5));
+  for (int i = 0; i < 6; ++i) {  // the cameras interleaved: 0, 1, 0, 1, ...
     auto uv = predict_landmark_pixel(s, s.x, s.landmarks()[i], i % 2, rig);
     ASSERT_TRUE(uv);
     ms.push_back(*landmark_measurement(s, s.landmarks()[i], i % 2, rig, *uv + Eigen::Vector2d(2, -1), 3));
   }
-  ms.push_back(gps_measurement(s, Eigen::Vector3d(0.5, -0.3, 0.2), 1.5));
   ms.push_back(range_measurement(s, 0, rig, 15.5, 0.5));
   std::vector<const Measurement*> ptrs;
   for (const auto& m : ms) ptrs.push_back(&m);
   ASSERT_TRUE(ekf_update(s, ptrs));
 
-  // Dense reference: eq. 43-45.
+  // Dense reference: eq. 43-45, R with V V^T sigma^2 between any two projections of a camera.
   int rows = 0;
   for (const auto& m : ms) rows += m.dim();
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(rows, before.dim()), R = Eigen::MatrixXd::Zero(rows, rows);
@@ -163,14 +169,39 @@ TEST(Update, SparseUpdateEqualsDenseKalmanUpdate) {
     for (const auto& b : m.blocks) H.block(r, b.col, m.dim(), b.H.cols()) += b.H;
     R.block(r, r, m.dim(), m.dim()) = m.R;
     y.segment(r, m.dim()) = m.innovation();
+    int c = 0;
+    for (const auto& o : ms) {
+      if (m.camera >= 0 && o.camera == m.camera)
+        R.block(r, c, m.dim(), o.dim()) += m.orientation_sigma * m.orientation_sigma * m.V * o.V.transpose();
+      c += o.dim();
+    }
     r += m.dim();
   }
+  if (orientation_sigma > 0) EXPECT_GT(R.block(3, 7, 2, 2).norm(), 0.0);  // camera 0's first two projections
   const Eigen::MatrixXd S = H * before.P * H.transpose() + R;
   const Eigen::MatrixXd K = before.P * H.transpose() * S.inverse();
   const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(before.dim(), before.dim());
   EXPECT_LT((s.x - (before.x + K * y)).norm(), 1e-9);
   EXPECT_LT((s.P - (I - K * H) * before.P).norm(), 1e-9);
   EXPECT_EQ((s.P - s.P.transpose()).norm(), 0.0);
+  }
+}
+
+// A block whose innovation covariance is not positive definite leaves the whole state as it was,
+// the blocks before it included.
+TEST(Update, AFailingBlockLeavesTheStateUnchanged) {
+  std::mt19937_64 rng(6);
+  FilterState s = two_camera_state_with_landmarks(2, rng);
+  const FilterState before = s;
+  const CameraRig rig = nadir_rig();
+  auto uv = predict_landmark_pixel(s, s.x, s.landmarks()[0], 0, rig);
+  ASSERT_TRUE(uv);
+  const Measurement good = *landmark_measurement(s, s.landmarks()[0], 0, rig, *uv + Eigen::Vector2d(1, 1), 3);
+  Measurement bad = gps_measurement(s, Eigen::Vector3d(0.5, -0.3, 0.2), 1.5);
+  bad.R = -1e6 * SmallSq::Identity(3, 3);
+  ASSERT_FALSE(ekf_update(s, {&good, &bad}));
+  EXPECT_EQ((s.x - before.x).norm(), 0.0);
+  EXPECT_EQ((s.P - before.P).norm(), 0.0);
 }
 
 TEST(Triangulation, RecoversAKnownPoint) {
