@@ -22,8 +22,14 @@ namespace {
 
 struct CheckCommand {
   std::string dir, baseline, against, junit, markdown, json;
+  double tolerance = 0;  // relative, for --against; 0: bit for bit
   bool quiet = false, verbose = false;
 };
+
+std::string same_words(const CheckCommand& o) {
+  return o.tolerance > 0 ? fmt::format("the same within {:g}, timings aside", o.tolerance)
+                         : "identical, timings aside";
+}
 
 // The determinism check as a report: one row per data file.
 eval::CheckReport against_report(const eval::TreeComparison& c, const CheckCommand& o) {
@@ -33,8 +39,8 @@ eval::CheckReport against_report(const eval::TreeComparison& c, const CheckComma
   for (const auto& f : c.files) {
     eval::CheckRow row;
     row.metric = f.path;
-    row.rule = "identical";
-    row.detail = f.difference.empty() ? "identical, timings aside" : f.difference;
+    row.rule = o.tolerance > 0 ? fmt::format("identical within {:g}", o.tolerance) : "identical";
+    row.detail = f.difference.empty() ? same_words(o) : f.difference;
     row.verdict = f.difference.empty() ? eval::Verdict::kPass : eval::Verdict::kFail;
     r.failed += !f.difference.empty();
     r.rows.push_back(row);
@@ -45,7 +51,7 @@ eval::CheckReport against_report(const eval::TreeComparison& c, const CheckComma
 void print_against(const eval::TreeComparison& c, const CheckCommand& o) {
   for (const auto& f : c.files)
     if (!f.difference.empty()) fmt::print("{}: {}\n", f.path, f.difference);
-  if (c.identical()) fmt::print("{} and {}: identical, timings aside ({} data files)\n", o.dir, o.against, c.files.size());
+  if (c.identical()) fmt::print("{} and {}: {} ({} data files)\n", o.dir, o.against, same_words(o), c.files.size());
   else fmt::print("{} and {}: {} of {} data files differ\n", o.dir, o.against, c.differing(), c.files.size());
 }
 
@@ -58,11 +64,12 @@ void write_report(const std::string& path, const std::string& text) {
 int check_command(const CheckCommand& o) {
   if (o.baseline.empty() == o.against.empty())
     throw io::UsageError("give one of --baseline FILE (metric regressions) or --against DIR (determinism)");
+  if (o.tolerance != 0 && o.against.empty()) throw io::UsageError("--tolerance goes with --against DIR");
   eval::CheckReport r;
   if (o.against.empty()) {
     r = eval::check_against_baseline(eval::read_metric_set(o.dir), eval::read_baseline(o.baseline));
   } else {
-    const eval::TreeComparison c = eval::compare_results_trees(o.dir, o.against);
+    const eval::TreeComparison c = eval::compare_results_trees(o.dir, o.against, o.tolerance);
     r = against_report(c, o);
     if (!o.quiet || !c.identical()) print_against(c, o);
   }
@@ -83,6 +90,10 @@ Subcommand add_check(CLI::App& parent) {
   cmd->add_option("results", o->dir, "Results directory (wingman run) or Monte Carlo directory")->required();
   cmd->add_option("--baseline,-b", o->baseline, "Baseline file (wingman baseline)");
   cmd->add_option("--against", o->against, "Another results directory that must hold the same results");
+  cmd->add_option("--tolerance", o->tolerance,
+                  "With --against: numbers may differ by this much, relative above 1 and absolute below (1e-9: "
+                  "the rounding of another order of the same arithmetic); 0, the default, asks for identical files")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--junit", o->junit, "Also write JUnit XML (one testcase per metric) to this file");
   cmd->add_option("--markdown", o->markdown, "Also write a Markdown report (a pull-request comment) to this file");
   cmd->add_option("--json", o->json, "Also write the verdicts as JSON to this file");

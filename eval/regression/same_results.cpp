@@ -3,6 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <optional>
+#include <sstream>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -36,9 +40,48 @@ std::vector<std::string> cells(const std::string& line) {
 }
 
 bool no_value(const std::string& c) { return c.empty() || c == "nan" || c == "NaN"; }
+
+// Two numbers the same up to a tolerance (0: bit for bit), relative above 1 in magnitude and
+// absolute below: a velocity of 1e-6 m/s that rounding moves by 1e-15 is the same velocity.
+bool same_number(double x, double y, double rel_tol) {
+  if (x == y) return true;
+  if (rel_tol <= 0 || !std::isfinite(x) || !std::isfinite(y)) return false;
+  return std::abs(x - y) <= rel_tol * std::max({std::abs(x), std::abs(y), 1.0});
+}
+
+std::optional<double> as_number(const std::string& s) {
+  double v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+// Two fields the same: equal text, or numbers within the tolerance.
+bool same_field(const std::string& x, const std::string& y, double rel_tol) {
+  if (x == y) return true;
+  const auto a = as_number(x), b = as_number(y);
+  return a && b && same_number(*a, *b, rel_tol);
+}
+
+std::vector<std::string> words(const std::string& line) {
+  std::vector<std::string> out;
+  std::istringstream in(line);
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+bool same_line(const std::string& x, const std::string& y, double rel_tol) {
+  if (x == y) return true;
+  if (rel_tol <= 0) return false;
+  const auto a = words(x), b = words(y);
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (!same_field(a[i], b[i], rel_tol)) return false;
+  return true;
+}
 bool timing_column(const std::string& h) { return h.rfind("t_", 0) == 0 && h.size() > 5 && h.ends_with("_ms"); }
 
-std::string csv_difference(const fs::path& a, const fs::path& b) {
+std::string csv_difference(const fs::path& a, const fs::path& b, double rel_tol) {
   const auto la = lines_of(a), lb = lines_of(b);
   if (la.empty() || lb.empty()) return la.size() == lb.size() ? "" : "one file is empty";
   if (la[0] != lb[0]) return fmt::format("header differs: '{}' vs '{}'", la[0], lb[0]);
@@ -50,7 +93,7 @@ std::string csv_difference(const fs::path& a, const fs::path& b) {
     if (x.size() != y.size()) return fmt::format("row {}: {} fields vs {}", r, x.size(), y.size());
     for (std::size_t c = 0; c < x.size(); ++c) {
       const std::string name = c < header.size() ? header[c] : fmt::format("#{}", c + 1);
-      if (x[c] != y[c] && !(no_value(x[c]) && no_value(y[c])) && !timing_column(name))
+      if (!same_field(x[c], y[c], rel_tol) && !(no_value(x[c]) && no_value(y[c])) && !timing_column(name))
         return fmt::format("row {}, column {}: {} vs {}", r, name, x[c], y[c]);
     }
   }
@@ -64,7 +107,7 @@ bool ignored_key(const std::string& k, const json& x) {
   return keys.count(k) || k.ends_with("_ms") || k.ends_with("_ms_per_step") || (k == "scenario" && x.is_string());
 }
 
-std::string json_difference(const json& x, const json& y, const std::string& path) {
+std::string json_difference(const json& x, const json& y, const std::string& path, double rel_tol) {
   if (x.is_object() && y.is_object()) {
     std::set<std::string> keys;
     for (const auto& [k, v] : x.items()) keys.insert(k);
@@ -73,25 +116,26 @@ std::string json_difference(const json& x, const json& y, const std::string& pat
       const std::string sub = path.empty() ? k : path + "." + k;
       if (ignored_key(k, x.contains(k) ? x[k] : y[k])) continue;  // on one side only, too (frame_cache)
       if (!x.contains(k) || !y.contains(k)) return fmt::format("{}: only in {}", sub, x.contains(k) ? "A" : "B");
-      if (auto d = json_difference(x[k], y[k], sub); !d.empty()) return d;
+      if (auto d = json_difference(x[k], y[k], sub, rel_tol); !d.empty()) return d;
     }
     return "";
   }
   if (x.is_array() && y.is_array()) {
     if (x.size() != y.size()) return fmt::format("{}: {} items vs {}", path, x.size(), y.size());
     for (std::size_t i = 0; i < x.size(); ++i)
-      if (auto d = json_difference(x[i], y[i], fmt::format("{}[{}]", path, i)); !d.empty()) return d;
+      if (auto d = json_difference(x[i], y[i], fmt::format("{}[{}]", path, i), rel_tol); !d.empty()) return d;
     return "";
   }
+  if (x.is_number() && y.is_number() && same_number(x.get<double>(), y.get<double>(), rel_tol)) return "";
   return x == y ? "" : fmt::format("{}: {} vs {}", path.empty() ? "(document)" : path, x.dump(), y.dump());
 }
 
-std::string text_difference(const fs::path& a, const fs::path& b, bool skip_comments) {
+std::string text_difference(const fs::path& a, const fs::path& b, bool skip_comments, double rel_tol) {
   auto la = lines_of(a), lb = lines_of(b);
   if (skip_comments)
     for (auto* l : {&la, &lb}) std::erase_if(*l, [](const std::string& s) { return s.rfind("#", 0) == 0; });
   for (std::size_t i = 0; i < std::min(la.size(), lb.size()); ++i)
-    if (la[i] != lb[i]) return fmt::format("line {}: '{}' vs '{}'", i + 1, la[i], lb[i]);
+    if (!same_line(la[i], lb[i], rel_tol)) return fmt::format("line {}: '{}' vs '{}'", i + 1, la[i], lb[i]);
   return la.size() == lb.size() ? "" : fmt::format("{} lines vs {}", la.size(), lb.size());
 }
 
@@ -108,24 +152,24 @@ std::set<std::string> data_files(const fs::path& root) {
 
 }  // namespace
 
-std::string first_difference(const fs::path& a, const fs::path& b) {
+std::string first_difference(const fs::path& a, const fs::path& b, double rel_tol) {
   const std::string ext = a.extension().string();
-  if (ext == ".csv") return csv_difference(a, b);
+  if (ext == ".csv") return csv_difference(a, b, rel_tol);
   if (ext == ".json") {
     try {
-      return json_difference(read_json_file(a), read_json_file(b), "");
+      return json_difference(read_json_file(a), read_json_file(b), "", rel_tol);
     } catch (const std::runtime_error& e) {
       throw CheckInputError(e.what());
     }
   }
-  return text_difference(a, b, ext == ".yaml");
+  return text_difference(a, b, ext == ".yaml", rel_tol);
 }
 
 int TreeComparison::differing() const {
   return static_cast<int>(std::count_if(files.begin(), files.end(), [](const File& f) { return !f.difference.empty(); }));
 }
 
-TreeComparison compare_results_trees(const fs::path& a, const fs::path& b) {
+TreeComparison compare_results_trees(const fs::path& a, const fs::path& b, double rel_tol) {
   for (const auto& d : {a, b})
     if (!fs::is_directory(d)) throw CheckInputError(fmt::format("{}: no such directory", d.string()));
   const auto fa = data_files(a), fb = data_files(b);
@@ -136,7 +180,7 @@ TreeComparison compare_results_trees(const fs::path& a, const fs::path& b) {
   TreeComparison c;
   for (const auto& f : all) {
     if (!fa.count(f) || !fb.count(f)) c.files.push_back({f, fmt::format("only in {}", (fa.count(f) ? a : b).string())});
-    else c.files.push_back({f, first_difference(a / f, b / f)});
+    else c.files.push_back({f, first_difference(a / f, b / f, rel_tol)});
   }
   return c;
 }

@@ -8,6 +8,9 @@
 //               frame cache's use (frame_cache: hits and misses differ, the frames do not);
 //   YAML, TUM, PLY, TXT   line by line, comment lines (#) of YAML left out (they name paths).
 // Plots, videos, logs and images are not compared (they carry timings or encoder state).
+// With a relative tolerance, two numbers (a CSV field, a JSON number, a whitespace-separated word
+// of a text line) are the same when |a - b| <= tol max(|a|, |b|, 1): results that differ only by
+// the rounding of another order of the same arithmetic.
 #pragma once
 
 #include <filesystem>
@@ -27,10 +30,11 @@ struct TreeComparison {
 };
 
 // Throws CheckInputError (eval/regression/metric_set.hpp) when either is not a directory holding results.
-TreeComparison compare_results_trees(const std::filesystem::path& a, const std::filesystem::path& b);
+TreeComparison compare_results_trees(const std::filesystem::path& a, const std::filesystem::path& b,
+                                     double rel_tol = 0);
 
 // The first difference of two files of the same kind ("" when the same), named by row and
 // column or key path.
-std::string first_difference(const std::filesystem::path& a, const std::filesystem::path& b);
+std::string first_difference(const std::filesystem::path& a, const std::filesystem::path& b, double rel_tol = 0);
 
 }  // namespace wingman::eval

@@ -240,6 +240,30 @@ TEST(SameResults, TheFirstDifferingFieldIsNamed) {
   EXPECT_EQ(difference_of(compare_results_trees(a, b), "landmarks.csv"), "only in " + a.string());
 }
 
+// With a tolerance, numbers that differ by rounding are the same (relative above 1, absolute
+// below) in CSV fields, JSON numbers and the words of text lines; a larger change is not.
+TEST(SameResults, ATolerancePassesRoundingAndNothingLarger) {
+  TempDir tmp;
+  const fs::path a = write_run(tmp.path() / "a"), b = write_run(tmp.path() / "b");
+  put(a / "extra.csv", "x,y\n1234.5,2e-7\n");
+  put(a / "map.txt", "point 1234.5 2e-7\n");
+  put(b / "extra.csv", "x,y\n1234.5000000001,2.000000001e-7\n");
+  put(b / "map.txt", "point 1234.5000000001 2.000000001e-7\n");
+  std::string json = slurp(b / "metrics.json");
+  const auto pos = json.find("\"max_in_state\": 3");
+  ASSERT_NE(pos, std::string::npos);
+  put(b / "metrics.json", json.replace(pos, 17, "\"max_in_state\": 3.0000000000004"));
+  EXPECT_EQ(compare_results_trees(a, b).differing(), 3);
+  EXPECT_TRUE(compare_results_trees(a, b, 1e-9).identical());
+  put(b / "extra.csv", "x,y\n1234.5000002,2e-7\n");  // 1.6e-10 relative
+  put(b / "map.txt", "point 1234.5 2.1e-7\n");         // 1e-8 absolute
+  const auto c = compare_results_trees(a, b, 1e-9);
+  EXPECT_EQ(difference_of(c, "extra.csv"), "");
+  EXPECT_EQ(difference_of(c, "map.txt"), "line 1: 'point 1234.5 2e-7' vs 'point 1234.5 2.1e-7'");
+  put(b / "extra.csv", "x,y\n1234.50001,2e-7\n");  // 8e-9 relative
+  EXPECT_EQ(difference_of(compare_results_trees(a, b, 1e-9), "extra.csv"), "row 1, column x: 1234.5 vs 1234.50001");
+}
+
 }  // namespace
 }  // namespace wingman::eval
 
