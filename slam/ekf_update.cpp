@@ -1,5 +1,7 @@
 #include "slam/ekf_update.hpp"
 
+#include <cblas.h>
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 
@@ -33,21 +35,35 @@ Eigen::VectorXd single_measurement_correction(const FilterState& s, const Measur
 }
 
 namespace {
-// The measurements in groups whose noises are independent of each other's: one group per camera
-// (its projections share the gimbal's pointing error, eq. 45) and one for the rest, in the order
-// they first appear.
+// Rows per block of measurements whose noises are independent: small enough that the solves
+// (n m_i^2) stay well below the downdate (n^2 m), large enough for BLAS to run at speed.
+constexpr int kIndependentRows = 64;
+
+// The measurements in groups whose noises are independent of each other's, in the order they
+// first appear: one group per camera whose projections share the gimbal's pointing error (eq. 45),
+// and every other measurement in groups of at most kIndependentRows rows.
 std::vector<std::vector<const Measurement*>> independent_blocks(const std::vector<const Measurement*>& ms) {
-  std::vector<int> keys;
   std::vector<std::vector<const Measurement*>> out;
+  std::vector<std::pair<int, std::size_t>> camera_group;  // camera, index in out
+  int open = -1, open_rows = 0;                            // the group filling with independent rows
   for (const auto* m : ms) {
-    const int key = std::max(m->camera, -1);
-    auto it = std::find(keys.begin(), keys.end(), key);
-    if (it == keys.end()) {
-      keys.push_back(key);
-      out.emplace_back();
-      it = keys.end() - 1;
+    if (m->camera >= 0) {
+      auto it = std::find_if(camera_group.begin(), camera_group.end(), [&](const auto& g) { return g.first == m->camera; });
+      if (it == camera_group.end()) {
+        camera_group.emplace_back(m->camera, out.size());
+        out.emplace_back();
+        it = camera_group.end() - 1;
+      }
+      out[it->second].push_back(m);
+      continue;
     }
-    out[it - keys.begin()].push_back(m);
+    if (open < 0 || open_rows + m->dim() > kIndependentRows) {
+      open = static_cast<int>(out.size());
+      open_rows = 0;
+      out.emplace_back();
+    }
+    out[open].push_back(m);
+    open_rows += m->dim();
   }
   return out;
 }
@@ -124,11 +140,16 @@ bool block_update(FilterState& s, const std::vector<const Measurement*>& ms, con
   S = 0.5 * (S + S.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(S);
   if (llt.info() != Eigen::Success) return false;
-  // W = P H^T L^-T (S = L L^T), so K y = W L^-1 y and K S K^T = W W^T.
-  llt.matrixU().solveInPlace<Eigen::OnTheRight>(W);
+  // W = P H^T L^-T (S = L L^T), so K y = W L^-1 y and K S K^T = W W^T. The two O(n m^2) and
+  // O(n^2 m) kernels are BLAS's (dtrsm, dsyrk); P and W are column-major with leading dimension n.
+  const Eigen::MatrixXd& L = llt.matrixLLT();  // L in its lower triangle
+  const int n = s.dim();
+  cblas_dtrsm(CblasColMajor, CblasRight, CblasLower, CblasTrans, CblasNonUnit, n, rows, 1.0, L.data(),
+              static_cast<int>(L.outerStride()), W.data(), static_cast<int>(W.outerStride()));
   const Eigen::VectorXd v = llt.matrixL().solve(y);
-  s.x.noalias() += W * v;                                    // eq. 43
-  s.P.selfadjointView<Eigen::Lower>().rankUpdate(W, -1.0);  // eq. 44
+  s.x.noalias() += W * v;  // eq. 43
+  cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, n, rows, -1.0, W.data(),
+              static_cast<int>(W.outerStride()), 1.0, s.P.data(), static_cast<int>(s.P.outerStride()));  // eq. 44
   return true;
 }
 }  // namespace
