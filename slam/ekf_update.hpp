@@ -1,11 +1,11 @@
 // EKF correction (paper eq. 43-45) for a batch of measurements whose Jacobians are a few dense
-// blocks each. The batch is processed in independent blocks, one per camera (its projections
-// share the gimbal's noise) and one for the other sensors, each linearised at the prior, so the
-// result is the joint update up to rounding while no innovation covariance larger than one
-// camera's is factorised: O(n^2 m + n sum m_i^2 + sum m_i^3) for n states, m rows, m_i per
-// block, against O(n^2 m + n m^2 + m^3) jointly. P H^T is built Jacobian block by Jacobian
-// block (O(n m)), and the covariance update P -= W W^T with W = P H^T L^-T (S = L L^T) is a
-// symmetric rank-m_i update that keeps P exactly symmetric.
+// blocks each. The batch is processed in blocks whose noises are independent of each other's (a
+// camera's projections when they share its gimbal's noise; otherwise 64 rows at a time), each
+// linearised at the prior, so that the result is the joint update up to rounding while no large
+// innovation covariance is factorised: O(n^2 m + n sum m_i^2 + sum m_i^3) for n states, m rows,
+// m_i per block, against O(n^2 m + n m^2 + m^3) jointly. P H^T is built Jacobian block by
+// Jacobian block (O(n m)), and the covariance update P -= W W^T with W = P H^T L^-T (S = L L^T)
+// is a symmetric rank-m_i update (BLAS dsyrk) that keeps P exactly symmetric.
 #pragma once
 
 #include <Eigen/Core>
