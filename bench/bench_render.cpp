@@ -51,11 +51,12 @@ std::unique_ptr<render::GlContext> context_or_skip(benchmark::State& state, rend
 
 // Renders the view over and over (after one warm-up frame: framebuffers, shader compilation),
 // reporting frames per second and the process's CPU per frame.
+// regions: null for the whole frame, else render_regions() over them.
 void time_frames(benchmark::State& state, render::Renderer& renderer, const render::CameraView& view,
-                 const std::optional<render::LeadPose>& lead) {
+                 const std::optional<render::LeadPose>& lead, const std::vector<cv::Rect>* regions = nullptr) {
   const double cpu0 = process_cpu_seconds();
   for (auto _ : state) {
-    render::Frame f = renderer.render(view, lead);
+    render::Frame f = regions ? renderer.render_regions(view, lead, *regions) : renderer.render(view, lead);
     benchmark::DoNotOptimize(f.rgb.data);
     benchmark::DoNotOptimize(f.depth.data);
   }
@@ -86,6 +87,33 @@ void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
   const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
   renderer.render(view, lead);  // warm-up
   time_frames(state, renderer, view, lead);
+}
+
+// Region rendering (Renderer::render_regions) of the same camera at the default quality: `gates`
+// squares of 48 px (a landmark's search box with the detector's context) scattered over the frame
+// and 3 blocks of 125 px where the map wants new landmarks, about what active search reads; the
+// counter `fraction` is the share of the frame's pixels they cover.
+void render_paper_regions(benchmark::State& state) {
+  sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic.yaml").front();
+  const auto ctx = context_or_skip(state, render::GlBackend::Egl);
+  if (!ctx) return;
+  render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
+  const sim::OpenLoopTruth truth(scn);
+  const double t = 20.0;
+  const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t),
+                                truth.camera(0, t).position};
+  const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
+  const int w = view.camera.width(), h = view.camera.height();
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> x(0, w - 48), y(0, h - 48);
+  std::vector<cv::Rect> regions;
+  for (int i = 0; i < state.range(0); ++i) regions.emplace_back(x(rng), y(rng), 48, 48);
+  for (int i = 0; i < 3; ++i) regions.emplace_back(w / 2 - 187 + 125 * i, h / 2 - 62, 125, 125);
+  cv::Mat covered = cv::Mat::zeros(h, w, CV_8U);
+  for (const auto& r : regions) covered(r & cv::Rect(0, 0, w, h)).setTo(1);
+  renderer.render_regions(view, lead, regions);  // warm-up
+  time_frames(state, renderer, view, lead, &regions);
+  state.counters["fraction"] = static_cast<double>(cv::countNonZero(covered)) / (w * h);
 }
 
 // The floor's scene: a 200 m square of the paper world's ground texture under a camera at 15 m
@@ -135,6 +163,8 @@ BENCHMARK(BM_FloorEgl)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FloorOsMesa)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_RenderEgl(benchmark::State& s) { render_paper_camera(s, render::GlBackend::Egl); }
+void BM_RegionsEgl(benchmark::State& s) { render_paper_regions(s); }
+BENCHMARK(BM_RegionsEgl)->Arg(20)->Arg(60)->Arg(120)->ArgName("gates")->Unit(benchmark::kMillisecond)->UseRealTime();
 void BM_RenderOsMesa(benchmark::State& s) { render_paper_camera(s, render::GlBackend::OsMesa); }
 
 // Arguments: MSAA samples, max anisotropy, trilinear (1) or bilinear (0) between mipmap levels

@@ -48,6 +48,7 @@ namespace wingman::render {
   X(PFNGLDRAWELEMENTSPROC, DrawElements) X(PFNGLFINISHPROC, Finish)                             \
   X(PFNGLMULTIDRAWELEMENTSPROC, MultiDrawElements) X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)   \
   X(PFNGLCOLORMASKPROC, ColorMask) X(PFNGLPOLYGONOFFSETPROC, PolygonOffset)                   \
+  X(PFNGLSCISSORPROC, Scissor)                                                                  \
   X(PFNGLTEXPARAMETERFVPROC, TexParameterfv)
 
 struct GlFunctions {

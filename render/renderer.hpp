@@ -60,6 +60,13 @@ class Renderer {
   // Rows [row0, row0 + rows) of that image, and only they are drawn (a rolling shutter's band):
   // the same pixels as render()'s rows; all of them is render() itself.
   Frame render_rows(const CameraView& view, const std::optional<LeadPose>& lead, int row0, int rows);
+  // Only the pixels inside `regions` (clipped to the image) are read back, drawn with the whole
+  // frame's viewport and projection under scissor rectangles that cover them (nearby regions
+  // share one draw where that is cheaper), so that they equal render()'s pixels there; elsewhere
+  // the frame is 0 (black, and depth 0: no surface). The frame has the image's size. A camera
+  // with lens distortion gets render()'s whole frame.
+  Frame render_regions(const CameraView& view, const std::optional<LeadPose>& lead,
+                       const std::vector<cv::Rect>& regions);
   // Nothing when the scene has no lead model or the lead is wholly behind the camera. A window
   // wider or taller than max_side px is cut to the image and a margin of max_side / 4 around it.
   std::optional<LeadSilhouette> lead_silhouette(const CameraView& view, const LeadPose& lead,
@@ -76,8 +83,11 @@ class Renderer {
   struct Impl;
   struct Undistort;
   const Undistort& undistort(const geometry::PinholeCamera& cam);
+  // regions: null for the whole image, else the scissor rectangles to draw; read: the rectangles
+  // read back (null: the drawn ones).
   Frame render_pinhole(double fx, double fy, double cx, double cy, int w, int h,
-                       const CameraView& view, const std::optional<LeadPose>& lead);
+                       const CameraView& view, const std::optional<LeadPose>& lead,
+                       const std::vector<cv::Rect>* regions = nullptr, const std::vector<cv::Rect>* read = nullptr);
   GlContext& ctx_;
   std::unique_ptr<Impl> impl_;
   std::map<std::tuple<double, double, double, double, int, int, double, double, double, double,

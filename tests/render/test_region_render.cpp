@@ -1,0 +1,66 @@
+// Region rendering: only the pixels inside a frame's regions are drawn and read back, under a
+// scissor rectangle with the whole frame's projection, so they are the whole frame's pixels there.
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+
+#include <random>
+#include <vector>
+
+#include "geometry/rotation.hpp"
+#include "render/renderer.hpp"
+#include "render_test_support.hpp"
+
+namespace wingman::render {
+namespace {
+
+using testing::backend_name;
+
+// A textured ground (mipmapped noise, sampled trilinearly) with bright targets on it.
+Scene textured_scene(int msaa) {
+  Scene s = testing::target_scene({{0, 0, 0.01}, {3, 2, 0.01}, {-4, -3, 0.01}}, 0.6, 0.3);
+  Material ground;
+  ground.texture = cv::Mat(256, 256, CV_8UC3);
+  cv::randu(ground.texture, cv::Scalar::all(0), cv::Scalar::all(255));
+  s.materials.push_back(ground);
+  s.static_meshes.front() = testing::square({0, 0, 0}, 60, {1, 1, 1}, 1, 0.2);
+  s.msaa = msaa;
+  return s;
+}
+
+class RegionRenderTest : public ::testing::TestWithParam<GlBackend> {};
+
+TEST_P(RegionRenderTest, ARegionsPixelsAreTheWholeFramesAndTheRestIsZero) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  const geometry::PinholeCamera cam(210.3, 190.7, 161.3, 118.6, 320, 240);
+  const CameraView view{cam, {geometry::nadir_R_CW(), {0.37, -0.21, 20}}};
+  // Inside, on the border, and partly outside the image (clipped to it).
+  const std::vector<cv::Rect> regions = {{40, 30, 64, 48}, {150, 100, 33, 57}, {0, 200, 90, 40},
+                                         {290, -10, 60, 50}};
+  for (const int msaa : {1, 4}) {
+    SCOPED_TRACE("msaa " + std::to_string(msaa));
+    Renderer r(ctx, textured_scene(msaa));
+    const Frame whole = r.render(view);
+    const Frame part = r.render_regions(view, std::nullopt, regions);
+    ASSERT_EQ(part.rgb.size(), whole.rgb.size());
+    cv::Mat inside = cv::Mat::zeros(whole.rgb.size(), CV_8U);
+    for (const cv::Rect& reg : regions) {
+      const cv::Rect c = reg & cv::Rect(0, 0, cam.width(), cam.height());
+      inside(c).setTo(255);
+      EXPECT_EQ(cv::norm(part.rgb(c), whole.rgb(c), cv::NORM_INF), 0) << "region " << reg << " on " << ctx.description();
+      EXPECT_EQ(cv::norm(part.depth(c), whole.depth(c), cv::NORM_INF), 0) << "region " << reg;
+    }
+    EXPECT_GT(cv::norm(whole.rgb, cv::NORM_INF), 100);  // the texture is there
+    cv::Mat outside;
+    cv::bitwise_not(inside, outside);
+    EXPECT_EQ(cv::norm(part.rgb, cv::NORM_INF, outside), 0);
+    EXPECT_EQ(cv::norm(part.depth, cv::NORM_INF, outside), 0);
+    EXPECT_EQ(cv::countNonZero(r.render_regions(view, std::nullopt, {}).depth), 0);  // no region: nothing
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RegionRenderTest, ::testing::Values(GlBackend::Egl, GlBackend::OsMesa),
+                         backend_name);
+
+}  // namespace
+}  // namespace wingman::render
