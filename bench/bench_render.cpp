@@ -74,17 +74,26 @@ void apply_quality(const benchmark::State& state, sim::Scenario& scn) {
       state.range(2) ? sim::TextureSpec::Filter::Trilinear : sim::TextureSpec::Filter::Bilinear;
 }
 
+// Quad 1's camera at t = 20 s in the paper's scene, and the lead then.
+struct PaperShot {
+  render::CameraView view;
+  render::LeadPose lead;
+};
+PaperShot paper_shot(const sim::Scenario& scn) {
+  const sim::OpenLoopTruth truth(scn);
+  const double t = 20.0;
+  const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t),
+                                truth.camera(0, t).position};
+  return {view, sim::lead_pose(truth, t, scn.world)};
+}
+
 void render_paper_camera(benchmark::State& state, render::GlBackend backend) {
   sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_synthetic.yaml").front();
   apply_quality(state, scn);
   const auto ctx = context_or_skip(state, backend);
   if (!ctx) return;
   render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
-  const sim::OpenLoopTruth truth(scn);
-  const double t = 20.0;
-  const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t),
-                                truth.camera(0, t).position};
-  const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
+  const auto [view, lead] = paper_shot(scn);
   renderer.render(view, lead);  // warm-up
   time_frames(state, renderer, view, lead);
 }
@@ -98,11 +107,7 @@ void render_paper_regions(benchmark::State& state) {
   const auto ctx = context_or_skip(state, render::GlBackend::Egl);
   if (!ctx) return;
   render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
-  const sim::OpenLoopTruth truth(scn);
-  const double t = 20.0;
-  const render::CameraView view{scn.uavs[0].camera.camera(), truth.camera_R_CW(0, t),
-                                truth.camera(0, t).position};
-  const render::LeadPose lead = sim::lead_pose(truth, t, scn.world);
+  const auto [view, lead] = paper_shot(scn);
   const int w = view.camera.width(), h = view.camera.height();
   std::mt19937 rng(7);
   std::uniform_int_distribution<int> x(0, w - 48), y(0, h - 48);
