@@ -121,7 +121,7 @@ bool block_update(FilterState& s, const std::vector<const Measurement*>& ms, con
     r += m->dim();
   }
   // S = H (P H^T) + R + V V^T sigma^2: the shared gimbal noise correlates every pair of
-  // projections of one camera (eq. 45), and a block holds one camera's.
+  // projections of one camera (eq. 45); a block with such projections holds that camera's only.
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(rows, rows);
   r = 0;
   for (const auto* a : ms) {
