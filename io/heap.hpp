@@ -7,8 +7,9 @@
 
 namespace wingman::io {
 
-// Allocations up to 32 MiB (glibc's largest threshold) come from the heap, and up to 256 MiB freed at its top stays there.
-// Call once, before the work starts; a no-op where the C library is not glibc.
+// Allocations up to 32 MiB (glibc's largest threshold) come from the heap, and up to 256 MiB
+// freed at its top stays there. Call once, before the work starts; a no-op where the C library is
+// not glibc.
 void keep_freed_memory_on_the_heap();
 
 }  // namespace wingman::io

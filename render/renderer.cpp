@@ -637,32 +637,39 @@ struct Renderer::Impl {
     return targets.emplace(std::make_pair(w, h), std::move(t)).first->second;
   }
 
+  // Frames are read from the single-sample framebuffer, rows packed tight.
+  void bind_for_reading(const Target& t) {
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
+    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  }
+
+  // Rectangle r of the bound framebuffer into rgba (CV_8UC4) and d (metric depth, CV_32F), both
+  // of r's size (GL's row 0 is image row 0).
+  void read_rect(const cv::Rect& r, cv::Mat& rgba, cv::Mat& d) {
+    gl.ReadPixels(r.x, r.y, r.width, r.height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+    gl.ReadPixels(r.x, r.y, r.width, r.height, GL_DEPTH_COMPONENT, GL_FLOAT, d.data);
+    to_metric_depth(d, depth);
+  }
+
   Frame read_whole(Target& t) {
     Frame f;
     f.depth.create(t.h, t.w, CV_32F);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-    gl.ReadPixels(0, 0, t.w, t.h, GL_RGBA, GL_UNSIGNED_BYTE, t.rgba.data);
-    gl.ReadPixels(0, 0, t.w, t.h, GL_DEPTH_COMPONENT, GL_FLOAT, f.depth.data);
+    bind_for_reading(t);
+    read_rect(cv::Rect(0, 0, t.w, t.h), t.rgba, f.depth);
     cv::cvtColor(t.rgba, f.rgb, cv::COLOR_RGBA2RGB);
-    to_metric_depth(f.depth, depth);
     return f;
   }
 
-  // Each region read back on its own into a frame of zeros (GL's row 0 is image row 0).
-  Frame read_regions(Target& t, const std::vector<cv::Rect>& rects) {
+  // Each rectangle read back on its own into a frame of zeros.
+  Frame read_rects(const Target& t, const std::vector<cv::Rect>& rects) {
     Frame f;
     f.rgb = cv::Mat::zeros(t.h, t.w, CV_8UC3);
     f.depth = cv::Mat::zeros(t.h, t.w, CV_32F);
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
-    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+    bind_for_reading(t);
     for (const cv::Rect& r : rects) {
       cv::Mat rgba(r.height, r.width, CV_8UC4), d(r.height, r.width, CV_32F);
-      gl.ReadPixels(r.x, r.y, r.width, r.height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
-      gl.ReadPixels(r.x, r.y, r.width, r.height, GL_DEPTH_COMPONENT, GL_FLOAT, d.data);
-      to_metric_depth(d, depth);
+      read_rect(r, rgba, d);
       cv::Mat rgb = f.rgb(r);
       cv::cvtColor(rgba, rgb, cv::COLOR_RGBA2RGB);
       d.copyTo(f.depth(r));
@@ -876,7 +883,7 @@ Eigen::Matrix4d model_matrix(const LeadPose& pose) {
 
 Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w, int h,
                                const CameraView& view, const std::optional<LeadPose>& lead,
-                               const std::vector<cv::Rect>* regions, const std::vector<cv::Rect>* read) {
+                               const Regions* regions) {
   ctx_.make_current();
   Impl& I = *impl_;
   auto& gl = I.gl;
@@ -905,7 +912,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   // Each region (or the whole image) is cleared and drawn under its scissor rectangle; the
   // rasteriser skips the tiles outside it.
   const std::vector<cv::Rect> whole = {cv::Rect(0, 0, w, h)};
-  const std::vector<cv::Rect>& rects = regions ? *regions : whole;
+  const std::vector<cv::Rect>& rects = regions ? regions->draw : whole;
   if (regions) gl.Enable(GL_SCISSOR_TEST);
   for (const cv::Rect& r : rects) {
     gl.Scissor(r.x, r.y, r.width, r.height);
@@ -929,12 +936,11 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   }
   if (regions) gl.Disable(GL_SCISSOR_TEST);
   gl.BindVertexArray(0);
-  Frame f = regions ? I.read_regions(t, read ? *read : rects) : I.read_whole(t);
+  Frame f = regions ? I.read_rects(t, regions->read) : I.read_whole(t);
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
     throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while rendering");
   return f;
 }
-
 
 namespace {
 
@@ -1080,7 +1086,7 @@ namespace {
 constexpr double kDrawCostPx = 9000;
 
 // Rectangles to draw that cover the regions: two are drawn as their bounding box whenever that
-// costs no more than drawing them apart, until no pair does (greedy, cheapest merge first).
+// costs no more than drawing them apart, until no pair does (greedy, the largest saving first).
 std::vector<cv::Rect> draw_rectangles(std::vector<cv::Rect> rects) {
   for (;;) {
     double best = 0;
@@ -1102,12 +1108,11 @@ Frame Renderer::render_regions(const CameraView& view, const std::optional<LeadP
   const auto& cam = view.camera;
   if (!cam.distortion().is_zero()) return render(view, lead);
   const cv::Rect image(0, 0, cam.width(), cam.height());
-  std::vector<cv::Rect> inside;
+  Regions rs;
   for (const cv::Rect& r : regions)
-    if (const cv::Rect c = r & image; !c.empty()) inside.push_back(c);
-  const std::vector<cv::Rect> draws = draw_rectangles(inside);
-  return render_pinhole(cam.fx(), cam.fy(), cam.cx(), cam.cy(), cam.width(), cam.height(), view, lead, &draws,
-                        &inside);
+    if (const cv::Rect c = r & image; !c.empty()) rs.read.push_back(c);
+  rs.draw = draw_rectangles(rs.read);
+  return render_pinhole(cam.fx(), cam.fy(), cam.cx(), cam.cy(), cam.width(), cam.height(), view, lead, &rs);
 }
 
 Frame Renderer::render_rows(const CameraView& view, const std::optional<LeadPose>& lead, int row0, int rows) {

@@ -83,11 +83,14 @@ class Renderer {
   struct Impl;
   struct Undistort;
   const Undistort& undistort(const geometry::PinholeCamera& cam);
-  // regions: null for the whole image, else the scissor rectangles to draw; read: the rectangles
-  // read back (null: the drawn ones).
+  // Part of a frame: the scissor rectangles drawn, and the rectangles read back (inside them).
+  struct Regions {
+    std::vector<cv::Rect> draw, read;
+  };
+  // regions: null for the whole image.
   Frame render_pinhole(double fx, double fy, double cx, double cy, int w, int h,
                        const CameraView& view, const std::optional<LeadPose>& lead,
-                       const std::vector<cv::Rect>* regions = nullptr, const std::vector<cv::Rect>* read = nullptr);
+                       const Regions* regions = nullptr);
   GlContext& ctx_;
   std::unique_ptr<Impl> impl_;
   std::map<std::tuple<double, double, double, double, int, int, double, double, double, double,

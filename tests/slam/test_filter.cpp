@@ -178,7 +178,9 @@ TEST(Update, BlocksInTurnEqualTheDenseJointKalmanUpdate) {
     }
     r += m.dim();
   }
-  if (orientation_sigma > 0) EXPECT_GT(R.block(3, 7, 2, 2).norm(), 0.0);  // camera 0's first two projections
+  if (orientation_sigma > 0) {
+    EXPECT_GT(R.block(3, 7, 2, 2).norm(), 0.0);  // camera 0's first two projections
+  }
   const Eigen::MatrixXd S = H * before.P * H.transpose() + R;
   const Eigen::MatrixXd K = before.P * H.transpose() * S.inverse();
   const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(before.dim(), before.dim());
