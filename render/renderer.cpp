@@ -229,6 +229,19 @@ std::vector<Chunk> chunk_triangles(const Mesh& m, double cell, std::vector<std::
 
 // Whether any of the box can be in front of the camera and inside the image (clip = PV x):
 // false only when all eight corners are beyond one side of the view frustum.
+// Clip space to one in which window rectangle r of a w x h viewport, grown by a pixel, spans the
+// clip cube's x and y: a box in_view() finds outside it draws no pixel of r.
+Eigen::Matrix4f region_from_clip(const cv::Rect& r, int w, int h) {
+  const float x0 = 2.f * static_cast<float>(r.x - 1) / static_cast<float>(w) - 1.f;
+  const float x1 = 2.f * static_cast<float>(r.x + r.width + 1) / static_cast<float>(w) - 1.f;
+  const float y0 = 2.f * static_cast<float>(r.y - 1) / static_cast<float>(h) - 1.f;
+  const float y1 = 2.f * static_cast<float>(r.y + r.height + 1) / static_cast<float>(h) - 1.f;
+  Eigen::Matrix4f T = Eigen::Matrix4f::Identity();
+  T(0, 0) = 2.f / (x1 - x0), T(0, 3) = -(x0 + x1) / (x1 - x0);
+  T(1, 1) = 2.f / (y1 - y0), T(1, 3) = -(y0 + y1) / (y1 - y0);
+  return T;
+}
+
 bool in_view(const Eigen::AlignedBox3f& box, const Eigen::Matrix4f& clip_from_world) {
   int outside[5] = {0, 0, 0, 0, 0};
   for (int i = 0; i < 8; ++i) {
@@ -330,6 +343,9 @@ struct Renderer::Impl {
   std::vector<GpuMesh> static_meshes, lead_meshes, body_meshes;
   std::vector<Eigen::Matrix4d> body_models;  // this render's UAV bodies (CameraView::bodies)
   std::map<std::pair<int, int>, Target> targets;
+  // Clip space to the clip space of the region being drawn: chunks wholly outside it are skipped
+  // (identity: the whole image).
+  Eigen::Matrix4f cull = Eigen::Matrix4f::Identity();
   std::vector<GLsizei> draw_counts;  // per-frame draw ranges, kept to avoid reallocating
   std::vector<const void*> draw_offsets;
   Scene info;  // light, sky, near, far, msaa (meshes cleared)
@@ -586,7 +602,7 @@ struct Renderer::Impl {
     }
     for (const auto& m : meshes) {
       if (pass.colour) bind_material(m.material >= 0 ? &materials[m.material] : nullptr, pass, M, current);
-      draw_visible(m, clip_from_model);
+      draw_visible(m, cull * clip_from_model);
     }
   }
 
@@ -916,6 +932,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   if (regions) gl.Enable(GL_SCISSOR_TEST);
   for (const cv::Rect& r : rects) {
     gl.Scissor(r.x, r.y, r.width, r.height);
+    if (regions) I.cull = region_from_clip(r, w, h);
     gl.BindFramebuffer(GL_FRAMEBUFFER, t.samples > 1 ? t.ms_fbo : t.fbo);
     if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
     gl.ClearBufferfv(GL_COLOR, 0, sky);
@@ -935,6 +952,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
     }
   }
   if (regions) gl.Disable(GL_SCISSOR_TEST);
+  I.cull = Eigen::Matrix4f::Identity();
   gl.BindVertexArray(0);
   Frame f = regions ? I.read_rects(t, regions->read) : I.read_whole(t);
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)

@@ -97,6 +97,37 @@ LeadDetector::LeadDetector(const LeadDetectorSettings& settings) : cfg_(settings
   dictionary_ = parse_aruco_dictionary(cfg_.dictionary);
 }
 
+std::optional<cv::Rect> LeadFinder::window(cv::Size, const Eigen::Vector2d&) const { return std::nullopt; }
+
+std::optional<LeadDetection> LeadFinder::detect_in_window(const cv::Mat&, const Eigen::Vector2d&) {
+  throw std::logic_error("LeadFinder::detect_in_window: this finder reads the whole image");
+}
+
+namespace {
+
+// The marker's search region: (2 half + 1)^2 pixels around the prediction, cut to the image;
+// nothing when too little of it is left.
+std::optional<cv::Rect> marker_region(cv::Size size, const Eigen::Vector2d& predicted, int half) {
+  const cv::Rect roi = cv::Rect(cvRound(predicted.x()) - half, cvRound(predicted.y()) - half, 2 * half + 1,
+                                2 * half + 1) &
+                       cv::Rect(0, 0, size.width, size.height);
+  if (roi.width > 8 && roi.height > 8) return roi;
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<cv::Rect> LeadDetector::window(cv::Size size, const Eigen::Vector2d& predicted) const {
+  if (cfg_.method != LeadMethod::Marker) return std::nullopt;
+  return marker_region(size, predicted, cfg_.roi_half_px);
+}
+
+std::optional<LeadDetection> LeadDetector::detect_in_window(const cv::Mat& image, const Eigen::Vector2d& predicted) {
+  if (!window(image.size(), predicted))
+    throw std::logic_error("LeadDetector::detect_in_window: no window (a colour panel, or a prediction off the image)");
+  return detect_marker(lead_search_grey(image, "LeadDetector::detect_in_window"), predicted, false);
+}
+
 std::optional<LeadDetection> LeadDetector::detect(const cv::Mat& image,
                                                   const std::optional<Eigen::Vector2d>& predicted) {
   if (image.empty()) throw std::invalid_argument("LeadDetector::detect: empty image");
@@ -124,7 +155,8 @@ std::optional<LeadDetection> LeadDetector::detect(const cv::Mat& image,
 }
 
 std::optional<LeadDetection> LeadDetector::detect_marker(const cv::Mat& grey,
-                                                         const std::optional<Eigen::Vector2d>& predicted) const {
+                                                         const std::optional<Eigen::Vector2d>& predicted,
+                                                         bool whole_image) const {
   const auto dict = cv::aruco::getPredefinedDictionary(dictionary_);
   auto params = cv::aruco::DetectorParameters::create();
   params->minMarkerPerimeterRate = 0.01;  // down to ~2.5 px per side on 1000 px: small markers
@@ -165,20 +197,17 @@ std::optional<LeadDetection> LeadDetector::detect_marker(const cv::Mat& grey,
   // markers), then the whole frame (a bad prediction).
   std::vector<Found> found;
   if (predicted) {
-    const cv::Rect roi = cv::Rect(cvRound(predicted->x()) - cfg_.roi_half_px,
-                                  cvRound(predicted->y()) - cfg_.roi_half_px, 2 * cfg_.roi_half_px + 1,
-                                  2 * cfg_.roi_half_px + 1) &
-                         cv::Rect(0, 0, grey.cols, grey.rows);
-    if (roi.width > 8 && roi.height > 8) {
-      found = run(grey(roi).clone(), 1.0, cv::Point2d(roi.x, roi.y));
+    if (const auto roi = marker_region(grey.size(), *predicted, cfg_.roi_half_px)) {
+      const cv::Mat crop = grey(*roi).clone();  // nothing outside the region is read
+      found = run(crop, 1.0, cv::Point2d(roi->x, roi->y));
       if (found.empty() && cfg_.upscale > 1.0) {
         cv::Mat up;
-        cv::resize(grey(roi), up, cv::Size(), cfg_.upscale, cfg_.upscale, cv::INTER_CUBIC);
-        found = run(up, cfg_.upscale, cv::Point2d(roi.x, roi.y));
+        cv::resize(crop, up, cv::Size(), cfg_.upscale, cfg_.upscale, cv::INTER_CUBIC);
+        found = run(up, cfg_.upscale, cv::Point2d(roi->x, roi->y));
       }
     }
   }
-  if (found.empty()) found = run(grey, 1.0, {0, 0});
+  if (found.empty() && whole_image) found = run(grey, 1.0, {0, 0});
   if (found.empty()) return std::nullopt;
 
   const auto pick = std::min_element(found.begin(), found.end(), [&](const Found& a, const Found& b) {

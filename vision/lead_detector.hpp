@@ -74,6 +74,12 @@ class LeadFinder {
   virtual ~LeadFinder() = default;
   virtual std::optional<LeadDetection> detect(const cv::Mat& image,
                                               const std::optional<Eigen::Vector2d>& predicted = std::nullopt) = 0;
+  // The window detect() searches first around `predicted` in an image of `size`: no pixel outside
+  // it is read unless the lead is not found there. Nothing: the finder reads the whole image.
+  virtual std::optional<cv::Rect> window(cv::Size size, const Eigen::Vector2d& predicted) const;
+  // detect() without the whole-image pass: the lead found in window(), or nothing. Only for a
+  // finder with a window (a caller holding the window's pixels alone, as a region render).
+  virtual std::optional<LeadDetection> detect_in_window(const cv::Mat& image, const Eigen::Vector2d& predicted);
 };
 
 class LeadDetector final : public LeadFinder {
@@ -84,10 +90,13 @@ class LeadDetector final : public LeadFinder {
   // the detection nearest to it is returned when several qualify.
   std::optional<LeadDetection> detect(const cv::Mat& image,
                                       const std::optional<Eigen::Vector2d>& predicted = std::nullopt) override;
+  // The marker's region around the prediction; nothing for a colour panel (read over the image).
+  std::optional<cv::Rect> window(cv::Size size, const Eigen::Vector2d& predicted) const override;
+  std::optional<LeadDetection> detect_in_window(const cv::Mat& image, const Eigen::Vector2d& predicted) override;
 
  private:
-  std::optional<LeadDetection> detect_marker(const cv::Mat& grey,
-                                             const std::optional<Eigen::Vector2d>& predicted) const;
+  std::optional<LeadDetection> detect_marker(const cv::Mat& grey, const std::optional<Eigen::Vector2d>& predicted,
+                                             bool whole_image = true) const;
   std::optional<LeadDetection> detect_colour(const cv::Mat& bgr,
                                              const std::optional<Eigen::Vector2d>& predicted) const;
   LeadDetectorSettings cfg_;

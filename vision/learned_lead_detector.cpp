@@ -71,29 +71,52 @@ std::pair<double, Eigen::Vector2d> LearnedLeadDetector::peak(const cv::Mat& grey
   return {best, Eigen::Vector2d(region.x + kStride * (at.x + x) - 0.5, region.y + kStride * (at.y + y) - 0.5)};
 }
 
+namespace {
+
+// A region a multiple of the stride in size, inside an image of `size`.
+cv::Rect fit(cv::Rect r, cv::Size size) {
+  r &= cv::Rect(0, 0, size.width, size.height);
+  r.width -= r.width % kStride;
+  r.height -= r.height % kStride;
+  return r;
+}
+
+}  // namespace
+
+std::optional<cv::Rect> LearnedLeadDetector::window(cv::Size size, const Eigen::Vector2d& predicted) const {
+  const int h = cfg_.window_half_px;
+  const int x0 = std::clamp(static_cast<int>(std::lround(predicted.x())) - h, 0, std::max(0, size.width - 2 * h));
+  const int y0 = std::clamp(static_cast<int>(std::lround(predicted.y())) - h, 0, std::max(0, size.height - 2 * h));
+  const cv::Rect w = fit({x0, y0, 2 * h, 2 * h}, size);
+  if (w.width >= 16 && w.height >= 16) return w;
+  return std::nullopt;
+}
+
 std::optional<LeadDetection> LearnedLeadDetector::detect(const cv::Mat& image,
                                                          const std::optional<Eigen::Vector2d>& predicted) {
+  return find(image, predicted, true);
+}
+
+std::optional<LeadDetection> LearnedLeadDetector::detect_in_window(const cv::Mat& image,
+                                                                   const Eigen::Vector2d& predicted) {
+  if (!window(image.size(), predicted))
+    throw std::logic_error("LearnedLeadDetector::detect_in_window: the image is smaller than the window");
+  return find(image, predicted, false);
+}
+
+std::optional<LeadDetection> LearnedLeadDetector::find(const cv::Mat& image,
+                                                       const std::optional<Eigen::Vector2d>& predicted,
+                                                       bool whole_image) {
   cv::Mat grey = lead_search_grey(image, "LearnedLeadDetector::detect");
-  // Regions a multiple of the stride in size, inside the image.
-  auto fit = [&](cv::Rect r) {
-    r &= cv::Rect(0, 0, grey.cols, grey.rows);
-    r.width -= r.width % kStride;
-    r.height -= r.height % kStride;
-    return r;
-  };
   std::optional<std::pair<double, Eigen::Vector2d>> found;
   if (predicted) {
-    const int h = cfg_.window_half_px;
-    const int x0 = std::clamp(static_cast<int>(std::lround(predicted->x())) - h, 0, std::max(0, grey.cols - 2 * h));
-    const int y0 = std::clamp(static_cast<int>(std::lround(predicted->y())) - h, 0, std::max(0, grey.rows - 2 * h));
-    const cv::Rect window = fit({x0, y0, 2 * h, 2 * h});
-    if (window.width >= 16 && window.height >= 16) {
-      const auto p = peak(grey, window);
+    if (const auto w = window(grey.size(), *predicted)) {
+      const auto p = peak(grey, *w);
       if (p.first >= cfg_.threshold) found = p;
     }
   }
-  if (!found) {
-    const cv::Rect whole = fit({0, 0, grey.cols, grey.rows});
+  if (!found && whole_image) {
+    const cv::Rect whole = fit({0, 0, grey.cols, grey.rows}, grey.size());
     if (whole.width < 16 || whole.height < 16) return std::nullopt;
     const auto p = peak(grey, whole);
     if (p.first >= cfg_.threshold) found = p;

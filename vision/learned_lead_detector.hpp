@@ -40,9 +40,13 @@ class LearnedLeadDetector final : public LeadFinder {
   // `image`: 8-bit grey (or BGR, turned grey).
   std::optional<LeadDetection> detect(const cv::Mat& image,
                                       const std::optional<Eigen::Vector2d>& predicted = std::nullopt) override;
+  std::optional<cv::Rect> window(cv::Size size, const Eigen::Vector2d& predicted) const override;
+  std::optional<LeadDetection> detect_in_window(const cv::Mat& image, const Eigen::Vector2d& predicted) override;
   const LearnedLeadSettings& settings() const { return cfg_; }
 
  private:
+  std::optional<LeadDetection> find(const cv::Mat& image, const std::optional<Eigen::Vector2d>& predicted,
+                                    bool whole_image);
   // The strongest cell of the network's maps over `region` of grey: probability and pixel.
   std::pair<double, Eigen::Vector2d> peak(const cv::Mat& grey, const cv::Rect& region) const;
   LearnedLeadSettings cfg_;

@@ -37,6 +37,7 @@ struct RunOptions {
   std::string video;
   bool no_plots = false;
   bool no_prefetch = false;
+  bool whole_frames = false;
   bool correspondences = false;
   bool force = false;
   bool quiet = false;
@@ -86,6 +87,7 @@ int run_command(const RunOptions& o) {
         throw io::UsageError("--video needs a scenario with measurements: rendered");
       RenderedOptions ro(gl, video);
       ro.prefetch = !o.no_prefetch;
+      ro.regions = !o.whole_frames;
       if (o.correspondences && scn.measurements != sim::MeasurementMode::Rendered)
         throw io::UsageError("--correspondences needs a scenario with measurements: rendered");
       ro.correspondences = o.correspondences;
@@ -145,6 +147,9 @@ Subcommand add_run(CLI::App& parent) {
   cmd->add_flag("--no-prefetch", o->no_prefetch,
                 "Rendered, open loop: render each step's frames at that step, not during the "
                 "previous step's detection (same results, for timing comparisons)");
+  cmd->add_flag("--whole-frames", o->whole_frames,
+                "Rendered, with active search: render whole frames, not only the regions the "
+                "frontend reads (same results, the reference path for timing comparisons)");
   cmd->add_flag("--correspondences", o->correspondences,
                 "Rendered scenarios: also write correspondences.csv per variant, every tracked "
                 "correspondence offered to the filter with its true projection, label and whether "

@@ -65,34 +65,58 @@ VisionFrontend::VisionFrontend(const RunConfig& cfg, const std::vector<int>& cam
   }
 }
 
-double VisionFrontend::detect(int cam, const render::Frame& frame, const slam::Estimator& est) {
+// Where the estimate puts the lead in camera cam's image (estimated camera, commanded orientation).
+void VisionFrontend::predict_lead(int cam, const slam::Estimator& est) {
   Cam& c = cams_[cam];
-  // Where the estimate puts the lead in this image (estimated camera, commanded orientation).
   const Eigen::Vector3d p_est = est.camera(cam).R_CW * (est.lead_position() - est.camera_position(cam));
-  std::optional<Eigen::Vector2d> predicted = c.model.project(p_est);
-  if (predicted && !c.model.in_image(*predicted, -100)) predicted.reset();
+  c.predicted = c.model.project(p_est);
+  if (c.predicted && !c.model.in_image(*c.predicted, -100)) c.predicted.reset();
+  c.predicted_depth = p_est.z();
+}
 
+std::optional<std::vector<cv::Rect>> VisionFrontend::reads(int cam) const {
+  const Cam& c = cams_[cam];
+  if (!c.plan || c.plan->whole_frame || !c.predicted || colour_lead_) return std::nullopt;
+  const auto window = c.lead_finder->window({c.model.width(), c.model.height()}, *c.predicted);
+  if (!window) return std::nullopt;
+  const int m = features_.crop_margin();
+  std::vector<cv::Rect> out{*window};
+  for (const cv::Rect& r : c.plan->regions) out.emplace_back(r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m);
+  return out;
+}
+
+double VisionFrontend::detect(int cam, const render::Frame& frame, bool partial) {
+  Cam& c = cams_[cam];
   const auto t0 = io::Clock::now();
   const cv::Mat grey = frame.gray();
   cv::Mat bgr;
   if (colour_lead_) cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
-  const auto det = c.lead_finder->detect(colour_lead_ ? bgr : grey, predicted);
-  c.lead.reset();
-  std::vector<vision::ExclusionBox> exclude;
-  if (det) {
-    c.lead = det->uv;
-    // A detection without a size (the learned detector's point) keeps the model's footprint free.
-    exclude.push_back(det->size_px > 0 ? vision::exclusion_box(*det)
-                                       : predicted_lead_box(det->uv, c.model.fx(), p_est.z(), cfg_));
-  } else if (predicted) {
-    exclude.push_back(predicted_lead_box(*predicted, c.model.fx(), p_est.z(), cfg_));
+  c.needs_whole_frame = false;
+  std::optional<vision::LeadDetection> det;
+  if (partial) {
+    det = c.lead_finder->detect_in_window(grey, *c.predicted);
+    c.needs_whole_frame = !det;
+  } else {
+    det = c.lead_finder->detect(colour_lead_ ? bgr : grey, c.predicted);
   }
-  c.features = detect_features(cam, grey, exclude);
-  const double ms = io::ms_since(t0);
+  c.lead.reset();
   c.marks = {};
   c.preds.clear();  // a camera whose landmarks are switched off tracks nothing this step
+  c.features = {};
+  if (!c.needs_whole_frame) {
+    std::vector<vision::ExclusionBox> exclude;
+    if (det) {
+      c.lead = det->uv;
+      // A detection without a size (the learned detector's point) keeps the model's footprint free.
+      exclude.push_back(det->size_px > 0 ? vision::exclusion_box(*det)
+                                         : predicted_lead_box(det->uv, c.model.fx(), c.predicted_depth, cfg_));
+    } else if (c.predicted) {
+      exclude.push_back(predicted_lead_box(*c.predicted, c.model.fx(), c.predicted_depth, cfg_));
+    }
+    c.features = detect_features(cam, grey, exclude);
+  }
   c.used.assign(c.features.size(), false);
-  return ms;
+  return io::ms_since(t0);
 }
 
 namespace {
@@ -152,6 +176,7 @@ std::vector<cv::Rect> VisionFrontend::carry_blocks(const std::vector<cv::Rect>& 
 // 0's image and carried into the others, so that a cooperative pair finds both of its pixels; their
 // number follows the largest deficit of the cameras (a pair asks for the larger of its two).
 void VisionFrontend::plan_step(const slam::Estimator& est) {
+  for (int j = 0; j < num_cameras(); ++j) predict_lead(j, est);
   const auto& active = cfg_.frontend.active_search;
   if (!active.enabled) return;
   const int target = cfg_.estimator.map.target_per_camera;
@@ -164,8 +189,12 @@ void VisionFrontend::plan_step(const slam::Estimator& est) {
   const auto blocks =
       vision::new_landmark_blocks({ref.model.width(), ref.model.height()}, ref.in_view, needed, active);
   const double ground_z = ground_height(est, ref.in_view);
-  for (int j = 0; j < num_cameras(); ++j)
-    cams_[j].blocks = j == 0 ? blocks : carry_blocks(blocks, 0, j, ground_z, est);
+  for (int j = 0; j < num_cameras(); ++j) {
+    Cam& c = cams_[j];
+    c.blocks = j == 0 ? blocks : carry_blocks(blocks, 0, j, ground_z, est);
+    c.plan = vision::plan_search({c.model.width(), c.model.height()}, c.in_view, c.blocks, features_.crop_margin(),
+                                 tracking_, active);
+  }
 }
 
 // The whole frame, or with active search the gates of the step's predictions in this camera and
@@ -174,11 +203,9 @@ vision::Features VisionFrontend::detect_features(int cam, const cv::Mat& grey,
                                                  const std::vector<vision::ExclusionBox>& exclude) {
   Cam& c = cams_[cam];
   c.searched = 1.0;
-  const auto& active = cfg_.frontend.active_search;
-  if (!active.enabled) return features_.detect(grey, exclude);
-  const auto plan = vision::plan_search(grey.size(), c.in_view, c.blocks, features_.crop_margin(), tracking_, active);
-  c.searched = plan.fraction;
-  return plan.whole_frame ? features_.detect(grey, exclude) : features_.detect_in(grey, plan.regions, exclude);
+  if (!c.plan) return features_.detect(grey, exclude);
+  c.searched = c.plan->fraction;
+  return c.plan->whole_frame ? features_.detect(grey, exclude) : features_.detect_in(grey, c.plan->regions, exclude);
 }
 
 std::vector<VisionFrontend::Feature> VisionFrontend::track(int cam,

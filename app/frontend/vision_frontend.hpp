@@ -17,6 +17,7 @@
 #include "vision/cross_match.hpp"
 #include "vision/descriptor_store.hpp"
 #include "vision/features.hpp"
+#include "vision/active_search.hpp"
 #include "vision/lead_detector.hpp"
 #include "vision/motion_lead_detector.hpp"
 #include "vision/tracking.hpp"
@@ -59,12 +60,21 @@ class VisionFrontend {
   const geometry::PinholeCamera& model(int cam) const { return cams_[cam].model; }
   int num_cameras() const { return static_cast<int>(cams_.size()); }
 
-  // Once a step, before its detection: what active search needs from the predicted state (every
-  // camera's predictions and the blocks for new landmarks).
+  // Once a step, before its detection: where the predicted state puts the lead in every camera,
+  // and what active search needs (every camera's predictions and gates, the blocks for new
+  // landmarks).
   void plan_step(const slam::Estimator& est);
+  // The pixels of camera `cam`'s frame that detect() reads this step when the lead is found in
+  // its finder's window: the planned crops with the detector's margin, and that window. Nothing:
+  // the whole frame (no active search or a whole-frame plan, no prediction of the lead, or a
+  // finder that reads the whole image).
+  std::optional<std::vector<cv::Rect>> reads(int cam) const;
   // The lead, searched first around where the estimate projects it, then features outside its
   // box; returns the milliseconds spent. Cameras may detect on different threads, one at a time.
-  double detect(int cam, const render::Frame& frame, const slam::Estimator& est);
+  // `partial`: the frame holds only reads(cam)'s pixels; a lead not found in the finder's window
+  // then leaves needs_whole_frame(cam) set and nothing detected.
+  double detect(int cam, const render::Frame& frame, bool partial = false);
+  bool needs_whole_frame(int cam) const { return cams_[cam].needs_whole_frame; }
   std::optional<Eigen::Vector2d> lead(int cam) const { return cams_[cam].lead; }
 
   // Keypoints for the filter's predictions in camera `cam`, by descriptor inside each ellipse.
@@ -95,7 +105,12 @@ class VisionFrontend {
     double searched = 1.0;
     std::vector<vision::LandmarkPrediction> in_view;  // plan_step's, for active search
     std::vector<cv::Rect> blocks;                      // where new landmarks are searched
+    std::optional<vision::SearchPlan> plan;            // plan_step's crops; nothing: no active search
+    std::optional<Eigen::Vector2d> predicted;          // the lead's pixel by the estimate
+    double predicted_depth = 0;                        // and its depth along the optical axis
+    bool needs_whole_frame = false;
   };
+  void predict_lead(int cam, const slam::Estimator& est);
   vision::Features detect_features(int cam, const cv::Mat& grey, const std::vector<vision::ExclusionBox>& exclude);
   std::vector<cv::Rect> carry_blocks(const std::vector<cv::Rect>& blocks, int from, int to, double ground_z,
                                      const slam::Estimator& est) const;

@@ -1,5 +1,6 @@
 #include "app/pipeline/camera_imaging.hpp"
 
+#include <stdexcept>
 #include <vector>
 
 #include "render/shutter.hpp"
@@ -53,7 +54,8 @@ CameraImaging::CameraImaging(const sim::Scenario& scn, int uav)
                 : std::nullopt),
       sensor_(scn.uavs[uav].camera.sensor, scn.uavs[uav].camera.shutter.exposure, model_, scn.seed,
               scn.uavs[uav].name),
-      effects_(scn.world.image, scn.seed, scn.uavs[uav].name) {}
+      effects_(scn.world.image, scn.seed, scn.uavs[uav].name),
+      effects_before_(effects_) {}
 
 double CameraImaging::exposure() const {
   return sensor_.physical() ? sensor_.next().exposure_s : scn_.uavs[uav_].camera.shutter.exposure;
@@ -64,7 +66,18 @@ bool CameraImaging::instant() const {
   return !s.rolling() && (exposure() == 0 || s.subframes == 1);
 }
 
+bool CameraImaging::per_pixel() const {
+  return instant() && !sensor_.physical() && scn_.world.image.blur_sigma == 0 && model_.distortion().is_zero();
+}
+
+TakenFrame CameraImaging::retake(const sim::Truth& truth, double t, const Draw& draw) {
+  if (!per_pixel()) throw std::logic_error("CameraImaging::retake: the camera's imaging has state of its own");
+  effects_ = effects_before_;
+  return take(truth, t, draw);
+}
+
 TakenFrame CameraImaging::take(const sim::Truth& truth, double t, const Draw& draw) {
+  effects_before_ = effects_;
   const sim::ShutterSpec& shutter = scn_.uavs[uav_].camera.shutter;
   const sim::KinematicState k = truth.camera(uav_, t);
   TakenFrame out;

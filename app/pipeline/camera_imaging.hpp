@@ -46,9 +46,16 @@ class CameraImaging {
   // Camera `uav`'s frame at time t, drawn over the exposure and readout with the motion of
   // true_poses() and the lead's own.
   TakenFrame take(const sim::Truth& truth, double t, const Draw& draw);
+  // The frame the last take() made, drawn again by `draw` with the same random draws of the
+  // image effects (a region frame that turned out to be needed whole). Only for per_pixel().
+  TakenFrame retake(const sim::Truth& truth, double t, const Draw& draw);
   // A global shutter with no exposure time: one render at the frame's time, the same for every
   // run of a seed-free truth (a frame cache may hold it).
   bool instant() const;
+  // An instant whose every pixel depends on its own rendered pixel alone (no blur, no physical
+  // sensor, whose noise draws and auto-exposure depend on the others, no lens distortion): a
+  // region of the frame is the same whether the rest is drawn or not.
+  bool per_pixel() const;
   const geometry::PinholeCamera& model() const { return model_; }
 
  private:
@@ -62,6 +69,7 @@ class CameraImaging {
   std::optional<render::Haze> haze_;
   render::SensorModel sensor_;
   render::ImageEffects effects_;
+  render::ImageEffects effects_before_;  // as the last take() found them, for retake()
 };
 
 }  // namespace wingman::app

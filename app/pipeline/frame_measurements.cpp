@@ -15,9 +15,13 @@ FrameMeasurements::FrameMeasurements(const RunConfig& cfg, const sim::Truth& tru
       frames_(std::move(frames)),
       samples_(std::move(samples)),
       frontend_(cfg, cam_uav_, options.features),
-      prefetch_(options.prefetch && frames_->renders()),
+      regions_(options.regions && options.video.empty() && cfg.frontend.active_search.enabled),
+      partial_(cam_uav_.size(), 0),
       now_(cam_uav_.size()),
       lead_(cam_uav_.size()) {
+  // Step k+1's regions are planned from step k's update: with regions, each camera's rendering
+  // overlaps the previous camera's detection instead.
+  prefetch_ = options.prefetch && frames_->renders() && !regions_;
   record_.enabled = true;
   record_.detector = frontend_.detector_name();
   record_.renderer = frames_->description();
@@ -57,8 +61,17 @@ StageTimes FrameMeasurements::begin_step(int k, double t, const slam::Estimator&
   return st;
 }
 
-void FrameMeasurements::detect_all(const slam::Estimator& est, StageTimes& st) {
-  for (int j = 0; j < frontend_.num_cameras(); ++j) st.detect_ms += frontend_.detect(j, now_[j].frame, est);
+void FrameMeasurements::detect_all(StageTimes& st) {
+  for (int j = 0; j < frontend_.num_cameras(); ++j) st.detect_ms += frontend_.detect(j, now_[j].frame);
+}
+
+void FrameMeasurements::produce(int j, int k, double t, StageTimes& st) {
+  const auto t0 = io::Clock::now();
+  partial_[j] = 0;
+  if (regions_)
+    if (const auto r = frontend_.reads(j)) partial_[j] = frames_->produce_regions(j, k, t, *r, now_[j]);
+  if (!partial_[j]) frames_->produce(j, k, t, now_[j]);
+  st.render_ms += io::ms_since(t0);
 }
 
 StageTimes FrameMeasurements::produce_and_detect(int k, double t, const slam::Estimator& est) {
@@ -77,13 +90,13 @@ StageTimes FrameMeasurements::produce_and_detect(int k, double t, const slam::Es
     st.render_ms += io::ms_since(t0);
   }
   if (have && !ahead) {  // the last step: nothing left to produce
-    detect_all(est, st);
+    detect_all(st);
   } else if (ahead) {
     // Step k's detection (the cameras one after the other: the extractor is not shared) on a
     // second thread while this one, which holds the GL context, renders step k+1.
-    auto detection = std::async(std::launch::async, [this, &est] {
+    auto detection = std::async(std::launch::async, [this] {
       StageTimes d;
-      detect_all(est, d);
+      detect_all(d);
       return d.detect_ms;
     });
     const auto t0 = io::Clock::now();
@@ -93,20 +106,33 @@ StageTimes FrameMeasurements::produce_and_detect(int k, double t, const slam::Es
     st.render_ms += io::ms_since(t0);
     st.detect_ms += detection.get();
   } else {
-    // Camera j's detection runs on a second thread while camera j+1 is produced (the GL context
-    // stays on this thread; two detections never run at once).
-    std::future<double> pending;
-    for (int j = 0; j < n; ++j) {
-      const auto t0 = io::Clock::now();
-      frames_->produce(j, k, t, now_[j]);
-      st.render_ms += io::ms_since(t0);
-      if (pending.valid()) st.detect_ms += pending.get();
-      pending = std::async(std::launch::async, [this, j, &est] { return frontend_.detect(j, now_[j].frame, est); });
-    }
-    if (pending.valid()) st.detect_ms += pending.get();
+    produce_and_detect_each(k, t, st);
   }
   st.wall_ms = io::ms_since(t_start);
   return st;
+}
+
+// Camera j's detection runs on a second thread while camera j+1 is produced (the GL context stays
+// on this thread; two detections never run at once). A camera whose regions missed the lead gets
+// its whole frame and is detected again, as the whole-frame path would have searched it.
+void FrameMeasurements::produce_and_detect_each(int k, double t, StageTimes& st) {
+  std::future<double> pending;
+  for (int j = 0; j < frontend_.num_cameras(); ++j) {
+    produce(j, k, t, st);
+    if (pending.valid()) st.detect_ms += pending.get();
+    pending = std::async(std::launch::async, [this, j] { return frontend_.detect(j, now_[j].frame, partial_[j]); });
+  }
+  if (pending.valid()) st.detect_ms += pending.get();
+  for (int j = 0; j < frontend_.num_cameras(); ++j) {
+    if (!frontend_.needs_whole_frame(j)) continue;
+    const auto t0 = io::Clock::now();
+    frames_->produce_whole(j, k, t, now_[j]);
+    partial_[j] = 0;
+    st.render_ms += io::ms_since(t0);
+    st.detect_ms += frontend_.detect(j, now_[j].frame);
+    ++record_.whole_frame_retries;
+  }
+  for (int j = 0; j < frontend_.num_cameras(); ++j) record_.region_frames += partial_[j];
 }
 
 Labelled<LandmarkObservation> FrameMeasurements::landmarks(int cam,

@@ -23,6 +23,9 @@ namespace wingman::app {
 
 struct FrameOptions {
   bool prefetch = false;        // render step k+1 during step k (open loop, renderer only)
+  // Render only the pixels the frontend reads (VisionFrontend::reads) where the producer can;
+  // false: whole frames (the reference path). Off with --video, which shows whole frames.
+  bool regions = true;
   bool correspondences = false;  // keep every tracked correspondence (RunRecord::frontend)
   std::string video;             // non-empty: VideoOverlay to this file
   std::optional<vision::FeatureSettings> features;  // overrides the frontend section's detector
@@ -50,7 +53,10 @@ class FrameMeasurements final : public MeasurementSource {
 
  private:
   StageTimes produce_and_detect(int k, double t, const slam::Estimator& est);
-  void detect_all(const slam::Estimator& est, StageTimes& st);
+  void detect_all(StageTimes& st);
+  void produce_and_detect_each(int k, double t, StageTimes& st);
+  // Camera j's frame of step k: its frontend's regions where it reads only those, else whole.
+  void produce(int j, int k, double t, StageTimes& st);
 
   const RunConfig& cfg_;
   const sim::Truth& truth_;
@@ -61,6 +67,8 @@ class FrameMeasurements final : public MeasurementSource {
   GroundTruthLabeller labeller_;
   std::unique_ptr<VideoOverlay> video_;
   bool prefetch_ = false;
+  bool regions_ = false;
+  std::vector<char> partial_;  // per camera: now_'s frame holds only the frontend's regions
   int k_ = 0;
   double t_ = 0;
   std::vector<CameraFrame> now_;                   // this step's frames, per filter camera

@@ -53,24 +53,44 @@ render::Frame RendererFrames::render(const render::CameraView& view, const rende
   return renderer().render_rows(view, lead, row0, rows);
 }
 
-void RendererFrames::produce(int cam, int, double t, CameraFrame& out) {
+void RendererFrames::produce(int cam, int, double t, CameraFrame& out) { take(cam, t, nullptr, false, out); }
+
+void RendererFrames::produce_whole(int cam, int, double t, CameraFrame& out) { take(cam, t, nullptr, true, out); }
+
+bool RendererFrames::produce_regions(int cam, int, double t, const std::vector<cv::Rect>& regions,
+                                     CameraFrame& out) {
+  if (cache_ || !imaging_[cam]->per_pixel()) return false;
+  take(cam, t, &regions, false, out);
+  return true;
+}
+
+void RendererFrames::take(int cam, double t, const std::vector<cv::Rect>* regions, bool again, CameraFrame& out) {
   CameraImaging& imaging = *imaging_[cam];
-  // The cache holds instants: an exposure or a rolling shutter renders every time.
-  const bool cached = cache_ && imaging.instant();
-  TakenFrame f = imaging.take(truth_, t, [&](const render::CameraView& view, const render::LeadPose& lead,
-                                              int row0, int rows) {
-    if (!cached) return render(view, lead, row0, rows);
-    const render::FrameKey key = keyer_->key(view, lead);
-    if (auto hit = cache_->load(key)) return std::move(*hit);
-    render::Frame frame = render(view, lead, row0, rows);
-    cache_->store(key, frame);
-    return frame;
-  });
-  out.frame = std::move(f.frame);
-  out.true_pose = std::move(f.poses);
   // The lead's label: its silhouette drawn alone at the frame's time (a small window, never cached).
   const render::LeadPose lead = sim::lead_pose(truth_, t, cfg_.world);
-  const auto silhouette = renderer().lead_silhouette({imaging.model(), out.true_pose.centre()}, lead);
+  const geometry::FramePoses poses = true_poses(cfg_, truth_, cam_uav_[cam], t);
+  const auto silhouette = renderer().lead_silhouette({imaging.model(), poses.centre()}, lead);
+  std::vector<cv::Rect> drawn;
+  if (regions) {
+    drawn = *regions;
+    // The label compares the silhouette with the frame's depth in its window: the label's pixels,
+    // drawn beside the frontend's (which reads only its own).
+    if (silhouette) drawn.push_back(silhouette->window);
+  }
+  // The cache holds instants: an exposure or a rolling shutter renders every time.
+  const bool cached = cache_ && imaging.instant();
+  const auto draw = [&](const render::CameraView& view, const render::LeadPose& at, int row0, int rows) {
+    if (regions) return renderer().render_regions(view, at, drawn);
+    if (!cached) return render(view, at, row0, rows);
+    const render::FrameKey key = keyer_->key(view, at);
+    if (auto hit = cache_->load(key)) return std::move(*hit);
+    render::Frame frame = render(view, at, row0, rows);
+    cache_->store(key, frame);
+    return frame;
+  };
+  TakenFrame f = again ? imaging.retake(truth_, t, draw) : imaging.take(truth_, t, draw);
+  out.frame = std::move(f.frame);
+  out.true_pose = std::move(f.poses);
   out.lead_truth = lead_label(truth_.lead(t).position, imaging.model(), out.true_pose, out.frame.depth, silhouette);
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,14 @@ class FrameProducer {
   virtual ~FrameProducer() = default;
   // Filter camera `cam`'s frame of step k at time t.
   virtual void produce(int cam, int k, double t, CameraFrame& out) = 0;
+  // The same frame with only `regions`' pixels (the rest 0), where that is the same as the whole
+  // frame's inside them; false (and `out` untouched): only the whole frame can be produced.
+  virtual bool produce_regions(int /*cam*/, int /*k*/, double /*t*/, const std::vector<cv::Rect>& /*regions*/,
+                               CameraFrame& /*out*/) {
+    return false;
+  }
+  // The frame produce_regions() last gave for `cam`, whole: the same frame, every pixel drawn.
+  virtual void produce_whole(int cam, int k, double t, CameraFrame& out) { produce(cam, k, t, out); }
   virtual std::string description() const = 0;
   // Whether step k+1 may be produced during step k (the renderer in open loop, whose truth is
   // known in advance).
@@ -62,6 +71,10 @@ class RendererFrames final : public FrameProducer {
                  const sim::Truth& truth, const FrameCacheOptions& cache = {});
   ~RendererFrames() override;
   void produce(int cam, int k, double t, CameraFrame& out) override;
+  // Without a frame cache, for a camera whose imaging works pixel by pixel
+  // (CameraImaging::per_pixel): the renderer's regions, and the lead label's window.
+  bool produce_regions(int cam, int k, double t, const std::vector<cv::Rect>& regions, CameraFrame& out) override;
+  void produce_whole(int cam, int k, double t, CameraFrame& out) override;
   std::string description() const override;
   bool renders() const override { return true; }
   void finish(eval::FrontendRecord& rec) const override;
@@ -69,6 +82,8 @@ class RendererFrames final : public FrameProducer {
  private:
   render::Renderer& renderer();  // made at the first use: a run the cache holds whole uploads once
   render::Frame render(const render::CameraView& view, const render::LeadPose& lead, int row0, int rows);
+  // The frame and its labels; `regions`: only those pixels are drawn.
+  void take(int cam, double t, const std::vector<cv::Rect>* regions, bool again, CameraFrame& out);
 
   const RunConfig& cfg_;
   std::vector<int> cam_uav_;

@@ -36,6 +36,7 @@ std::unique_ptr<MeasurementSource> make_source(const RunConfig& cfg, const sim::
   }
   FrameOptions fo;
   fo.prefetch = prefetch;
+  fo.regions = ro.regions;
   fo.correspondences = ro.correspondences;
   fo.video = ro.video;
   return std::make_unique<FrameMeasurements>(cfg, truth,

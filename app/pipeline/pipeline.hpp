@@ -29,6 +29,9 @@ struct RenderedOptions {
   std::string video;
   // Open loop: render step k+1 while step k's detection runs (same results, less wall time).
   bool prefetch = true;
+  // With active search: draw only the regions the frontend reads (same results, less rendering);
+  // false: whole frames, the reference path.
+  bool regions = true;
   // Keep every tracked correspondence with its true projection (RunRecord::frontend).
   bool correspondences = false;
   // Read frames the cache holds instead of rendering them (RendererFrames).

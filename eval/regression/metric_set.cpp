@@ -173,7 +173,8 @@ MetricSet read_metric_set(const fs::path& dir) {
 bool is_timing_metric(const std::string& path) {
   const auto key = path.substr(path.find('/') == std::string::npos ? 0 : path.find('/') + 1);
   return key == "wall_time_s" || key.rfind("timings_ms.", 0) == 0 || key.find("_ms_per_step") != std::string::npos ||
-         key.rfind("frame_cache.", 0) == 0;  // the cache's use: how a run got its frames, not what it found
+         key.rfind("frame_cache.", 0) == 0 ||  // the cache's use: how a run got its frames, not what it found
+         key.rfind("frame_regions.", 0) == 0;
 }
 
 std::vector<std::string> default_metrics(const MetricSet& set) {

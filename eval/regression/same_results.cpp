@@ -103,7 +103,7 @@ std::string csv_difference(const fs::path& a, const fs::path& b, double rel_tol)
 bool ignored_key(const std::string& k, const json& x) {
   static const std::set<std::string> keys = {"wall_time_s", "timings_ms", "software_version", "scenario_path",
                                              "path", "real_time_factor", "renderer",
-                                             "frame_cache"};
+                                             "frame_cache", "frame_regions"};
   return keys.count(k) || k.ends_with("_ms") || k.ends_with("_ms_per_step") || (k == "scenario" && x.is_string());
 }
 

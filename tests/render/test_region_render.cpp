@@ -1,9 +1,12 @@
 // Region rendering: only the pixels inside a frame's regions are drawn and read back, under a
-// scissor rectangle with the whole frame's projection, so they are the whole frame's pixels there.
+// scissor rectangle with the whole frame's projection, so they are the whole frame's pixels there
+// (the chunks of the scene outside a region skipped).
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
 
+#include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -16,6 +19,25 @@ namespace {
 
 using testing::backend_name;
 
+// A 60 m ground of 1 m cells with relief, so that the renderer splits it into chunks, some
+// outside each region.
+Mesh rough_ground(int material) {
+  Mesh m;
+  m.material = material;
+  constexpr int n = 60;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const double x = j - n / 2.0, y = i - n / 2.0;
+      m.add({x, y, 0.4 * std::sin(0.7 * x) * std::cos(0.5 * y) - 0.5}, {0, 0, 1}, {j / 8.0, i / 8.0}, {1, 1, 1});
+    }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const auto a = static_cast<std::uint32_t>(i * (n + 1) + j), b = a + 1, c = a + n + 1, d = c + 1;
+      m.indices.insert(m.indices.end(), {a, b, d, a, d, c});
+    }
+  return m;
+}
+
 // A textured ground (mipmapped noise, sampled trilinearly) with bright targets on it.
 Scene textured_scene(int msaa) {
   Scene s = testing::target_scene({{0, 0, 0.01}, {3, 2, 0.01}, {-4, -3, 0.01}}, 0.6, 0.3);
@@ -23,7 +45,7 @@ Scene textured_scene(int msaa) {
   ground.texture = cv::Mat(256, 256, CV_8UC3);
   cv::randu(ground.texture, cv::Scalar::all(0), cv::Scalar::all(255));
   s.materials.push_back(ground);
-  s.static_meshes.front() = testing::square({0, 0, 0}, 60, {1, 1, 1}, 1, 0.2);
+  s.static_meshes.front() = rough_ground(1);
   s.msaa = msaa;
   return s;
 }

@@ -168,16 +168,8 @@ TEST(RenderedPipeline, OraclePixelsFeedExactProjectionsOfCorrectCorrespondences)
   EXPECT_THAT(eval::format_summary(m, rec), ::testing::HasSubstr("ORACLE PIXELS"));
 }
 
-// Rendering step k+1 during step k's detection changes when frames are made, not what they are:
-// every figure but the timings is the same with it off.
-TEST(RenderedPipeline, PrefetchChangesTimingOnly) {
-  std::string why;
-  if (!gl_available(&why)) WINGMAN_NO_GL_CONTEXT(why);
-  app::RunConfig s = variant("multi");
-  s.duration = 3;
-  RenderedOptions on, off;
-  off.prefetch = false;
-  const auto a = run_scenario(s, on), b = run_scenario(s, off);
+// Every figure of two runs but the timings.
+void expect_same_run(const eval::RunRecord& a, const eval::RunRecord& b) {
   ASSERT_EQ(a.steps.size(), b.steps.size());
   for (std::size_t k = 0; k < a.steps.size(); ++k) {
     ASSERT_EQ(a.steps[k].agents.size(), b.steps[k].agents.size());
@@ -193,9 +185,41 @@ TEST(RenderedPipeline, PrefetchChangesTimingOnly) {
     EXPECT_EQ(a.outliers[c].outliers, b.outliers[c].outliers);
   }
   EXPECT_EQ(a.frontend.lead_error_px, b.frontend.lead_error_px);
+  EXPECT_EQ(a.frontend.accepted_error_px, b.frontend.accepted_error_px);
+  EXPECT_EQ(a.frontend.searched_fraction_sum, b.frontend.searched_fraction_sum);
   EXPECT_EQ(a.frontend.frames, b.frontend.frames);
   EXPECT_GT(a.landmarks.size(), 0u);
   EXPECT_EQ(a.landmarks.size(), b.landmarks.size());
+}
+
+// Rendering step k+1 during step k's detection changes when frames are made, not what they are:
+// every figure but the timings is the same with it off.
+TEST(RenderedPipeline, PrefetchChangesTimingOnly) {
+  std::string why;
+  if (!gl_available(&why)) WINGMAN_NO_GL_CONTEXT(why);
+  app::RunConfig s = variant("multi");
+  s.duration = 3;
+  RenderedOptions on, off;
+  on.regions = off.regions = false;  // with regions a step's rendering waits for its plan
+  off.prefetch = false;
+  expect_same_run(run_scenario(s, on), run_scenario(s, off));
+}
+
+// Drawing only the pixels the frontend reads (its crops and the lead's window) changes the cost,
+// not the frames it reads: every figure is the whole-frame path's, and most frames were regions.
+TEST(RenderedPipeline, RegionRenderingChangesTimingOnly) {
+  std::string why;
+  if (!gl_available(&why)) WINGMAN_NO_GL_CONTEXT(why);
+  app::RunConfig s = variant("multi");
+  s.duration = 4;
+  RenderedOptions regions, whole;
+  whole.regions = false;
+  const auto a = run_scenario(s, regions), b = run_scenario(s, whole);
+  expect_same_run(a, b);
+  EXPECT_EQ(b.frontend.region_frames, 0);
+  // The first steps (no map, no prediction of the lead) are whole; after them, regions.
+  EXPECT_GT(a.frontend.region_frames, a.frontend.frames / 2);
+  EXPECT_LT(a.frontend.whole_frame_retries, a.frontend.region_frames / 4);
 }
 
 TEST(RenderedPipeline, MissingLeadModelIsAnErrorNamingTheFile) {
