@@ -65,23 +65,21 @@ VisionFrontend::VisionFrontend(const RunConfig& cfg, const std::vector<int>& cam
   }
 }
 
-// Where the estimate puts the lead in camera cam's image (estimated camera, commanded orientation).
-void VisionFrontend::predict_lead(int cam, const slam::Estimator& est) {
-  Cam& c = cams_[cam];
-  const Eigen::Vector3d p_est = est.camera(cam).R_CW * (est.lead_position() - est.camera_position(cam));
-  c.predicted = c.model.project(p_est);
-  if (c.predicted && !c.model.in_image(*c.predicted, -100)) c.predicted.reset();
-  c.predicted_depth = p_est.z();
-}
-
-std::optional<std::vector<cv::Rect>> VisionFrontend::reads(int cam) const {
+std::optional<std::vector<cv::Rect>> VisionFrontend::reads(int cam, const CameraPlan& plan) const {
   const Cam& c = cams_[cam];
-  if (!c.plan || c.plan->whole_frame || !c.predicted || colour_lead_) return std::nullopt;
-  const auto window = c.lead_finder->window({c.model.width(), c.model.height()}, *c.predicted);
+  if (!plan.search || plan.search->whole_frame || !plan.lead || colour_lead_) return std::nullopt;
+  const auto window = c.lead_finder->window({c.model.width(), c.model.height()}, *plan.lead);
   if (!window) return std::nullopt;
   const int m = features_.crop_margin();
   std::vector<cv::Rect> out{*window};
-  for (const cv::Rect& r : c.plan->regions) out.emplace_back(r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m);
+  for (const cv::Rect& r : plan.search->regions) out.emplace_back(r.x - m, r.y - m, r.width + 2 * m, r.height + 2 * m);
+  return out;
+}
+
+std::vector<std::optional<std::vector<cv::Rect>>> VisionFrontend::reads_for(const slam::Estimator& est) const {
+  const auto plans = make_plans(est);
+  std::vector<std::optional<std::vector<cv::Rect>>> out;
+  for (int j = 0; j < num_cameras(); ++j) out.push_back(reads(j, plans[j]));
   return out;
 }
 
@@ -93,11 +91,12 @@ double VisionFrontend::detect(int cam, const render::Frame& frame, bool partial)
   if (colour_lead_) cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
   c.needs_whole_frame = false;
   std::optional<vision::LeadDetection> det;
+  const CameraPlan& plan = c.plan;
   if (partial) {
-    det = c.lead_finder->detect_in_window(grey, *c.predicted);
+    det = c.lead_finder->detect_in_window(grey, *plan.lead);
     c.needs_whole_frame = !det;
   } else {
-    det = c.lead_finder->detect(colour_lead_ ? bgr : grey, c.predicted);
+    det = c.lead_finder->detect(colour_lead_ ? bgr : grey, plan.lead);
   }
   c.lead.reset();
   c.marks = {};
@@ -109,9 +108,9 @@ double VisionFrontend::detect(int cam, const render::Frame& frame, bool partial)
       c.lead = det->uv;
       // A detection without a size (the learned detector's point) keeps the model's footprint free.
       exclude.push_back(det->size_px > 0 ? vision::exclusion_box(*det)
-                                         : predicted_lead_box(det->uv, c.model.fx(), c.predicted_depth, cfg_));
-    } else if (c.predicted) {
-      exclude.push_back(predicted_lead_box(*c.predicted, c.model.fx(), c.predicted_depth, cfg_));
+                                         : predicted_lead_box(det->uv, c.model.fx(), plan.lead_depth, cfg_));
+    } else if (plan.lead) {
+      exclude.push_back(predicted_lead_box(*plan.lead, c.model.fx(), plan.lead_depth, cfg_));
     }
     c.features = detect_features(cam, grey, exclude);
   }
@@ -175,26 +174,41 @@ std::vector<cv::Rect> VisionFrontend::carry_blocks(const std::vector<cv::Rect>& 
 // Every camera's predictions, and the blocks where the map needs new landmarks: chosen in camera
 // 0's image and carried into the others, so that a cooperative pair finds both of its pixels; their
 // number follows the largest deficit of the cameras (a pair asks for the larger of its two).
-void VisionFrontend::plan_step(const slam::Estimator& est) {
-  for (int j = 0; j < num_cameras(); ++j) predict_lead(j, est);
+std::vector<VisionFrontend::CameraPlan> VisionFrontend::make_plans(const slam::Estimator& est) const {
+  std::vector<CameraPlan> plans(cams_.size());
+  for (int j = 0; j < num_cameras(); ++j) {
+    // Where the estimate puts the lead in this image (estimated camera, commanded orientation).
+    const Cam& c = cams_[j];
+    const Eigen::Vector3d p_est = est.camera(j).R_CW * (est.lead_position() - est.camera_position(j));
+    plans[j].lead = c.model.project(p_est);
+    if (plans[j].lead && !c.model.in_image(*plans[j].lead, -100)) plans[j].lead.reset();
+    plans[j].lead_depth = p_est.z();
+  }
   const auto& active = cfg_.frontend.active_search;
-  if (!active.enabled) return;
+  if (!active.enabled) return plans;
   const int target = cfg_.estimator.map.target_per_camera;
   int needed = 0;
   for (int j = 0; j < num_cameras(); ++j) {
-    cams_[j].in_view = predictions(est, j);
-    needed = std::max(needed, target - static_cast<int>(cams_[j].in_view.size()));
+    plans[j].in_view = predictions(est, j);
+    needed = std::max(needed, target - static_cast<int>(plans[j].in_view.size()));
   }
   const Cam& ref = cams_[0];
   const auto blocks =
-      vision::new_landmark_blocks({ref.model.width(), ref.model.height()}, ref.in_view, needed, active);
-  const double ground_z = ground_height(est, ref.in_view);
+      vision::new_landmark_blocks({ref.model.width(), ref.model.height()}, plans[0].in_view, needed, active);
+  const double ground_z = ground_height(est, plans[0].in_view);
   for (int j = 0; j < num_cameras(); ++j) {
-    Cam& c = cams_[j];
-    c.blocks = j == 0 ? blocks : carry_blocks(blocks, 0, j, ground_z, est);
-    c.plan = vision::plan_search({c.model.width(), c.model.height()}, c.in_view, c.blocks, features_.crop_margin(),
-                                 tracking_, active);
+    CameraPlan& p = plans[j];
+    const Cam& c = cams_[j];
+    p.blocks = j == 0 ? blocks : carry_blocks(blocks, 0, j, ground_z, est);
+    p.search = vision::plan_search({c.model.width(), c.model.height()}, p.in_view, p.blocks, features_.crop_margin(),
+                                   tracking_, active);
   }
+  return plans;
+}
+
+void VisionFrontend::plan_step(const slam::Estimator& est) {
+  auto plans = make_plans(est);
+  for (int j = 0; j < num_cameras(); ++j) cams_[j].plan = std::move(plans[j]);
 }
 
 // The whole frame, or with active search the gates of the step's predictions in this camera and
@@ -203,9 +217,10 @@ vision::Features VisionFrontend::detect_features(int cam, const cv::Mat& grey,
                                                  const std::vector<vision::ExclusionBox>& exclude) {
   Cam& c = cams_[cam];
   c.searched = 1.0;
-  if (!c.plan) return features_.detect(grey, exclude);
-  c.searched = c.plan->fraction;
-  return c.plan->whole_frame ? features_.detect(grey, exclude) : features_.detect_in(grey, c.plan->regions, exclude);
+  const auto& search = c.plan.search;
+  if (!search) return features_.detect(grey, exclude);
+  c.searched = search->fraction;
+  return search->whole_frame ? features_.detect(grey, exclude) : features_.detect_in(grey, search->regions, exclude);
 }
 
 std::vector<VisionFrontend::Feature> VisionFrontend::track(int cam,

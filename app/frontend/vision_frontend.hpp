@@ -68,7 +68,11 @@ class VisionFrontend {
   // its finder's window: the planned crops with the detector's margin, and that window. Nothing:
   // the whole frame (no active search or a whole-frame plan, no prediction of the lead, or a
   // finder that reads the whole image).
-  std::optional<std::vector<cv::Rect>> reads(int cam) const;
+  std::optional<std::vector<cv::Rect>> reads(int cam) const { return reads(cam, cams_[cam].plan); }
+  // What reads() would give every camera for a step planned from `est` (a state predicted ahead,
+  // to draw a step's frames before its plan exists). Touches no camera's state: it may run while
+  // another thread detects.
+  std::vector<std::optional<std::vector<cv::Rect>>> reads_for(const slam::Estimator& est) const;
   // The lead, searched first around where the estimate projects it, then features outside its
   // box; returns the milliseconds spent. Cameras may detect on different threads, one at a time.
   // `partial`: the frame holds only reads(cam)'s pixels; a lead not found in the finder's window
@@ -94,6 +98,14 @@ class VisionFrontend {
   double searched_fraction(int cam) const { return cams_[cam].searched; }
 
  private:
+  // What a step's detection in one camera is planned to be.
+  struct CameraPlan {
+    std::vector<vision::LandmarkPrediction> in_view;  // for active search
+    std::vector<cv::Rect> blocks;                      // where new landmarks are searched
+    std::optional<vision::SearchPlan> search;          // the crops; nothing: no active search
+    std::optional<Eigen::Vector2d> lead;               // the lead's pixel by the estimate
+    double lead_depth = 0;                             // and its depth along the optical axis
+  };
   struct Cam {
     geometry::PinholeCamera model;
     vision::Features features;
@@ -103,14 +115,11 @@ class VisionFrontend {
     std::optional<Eigen::Vector2d> lead;
     Marks marks;
     double searched = 1.0;
-    std::vector<vision::LandmarkPrediction> in_view;  // plan_step's, for active search
-    std::vector<cv::Rect> blocks;                      // where new landmarks are searched
-    std::optional<vision::SearchPlan> plan;            // plan_step's crops; nothing: no active search
-    std::optional<Eigen::Vector2d> predicted;          // the lead's pixel by the estimate
-    double predicted_depth = 0;                        // and its depth along the optical axis
+    CameraPlan plan;  // plan_step's
     bool needs_whole_frame = false;
   };
-  void predict_lead(int cam, const slam::Estimator& est);
+  std::vector<CameraPlan> make_plans(const slam::Estimator& est) const;
+  std::optional<std::vector<cv::Rect>> reads(int cam, const CameraPlan& plan) const;
   vision::Features detect_features(int cam, const cv::Mat& grey, const std::vector<vision::ExclusionBox>& exclude);
   std::vector<cv::Rect> carry_blocks(const std::vector<cv::Rect>& blocks, int from, int to, double ground_z,
                                      const slam::Estimator& est) const;

@@ -1,6 +1,9 @@
 #include "app/pipeline/camera_imaging.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "render/shutter.hpp"
@@ -54,8 +57,7 @@ CameraImaging::CameraImaging(const sim::Scenario& scn, int uav)
                 : std::nullopt),
       sensor_(scn.uavs[uav].camera.sensor, scn.uavs[uav].camera.shutter.exposure, model_, scn.seed,
               scn.uavs[uav].name),
-      effects_(scn.world.image, scn.seed, scn.uavs[uav].name),
-      effects_before_(effects_) {}
+      effects_(scn.world.image, scn.seed, scn.uavs[uav].name) {}
 
 double CameraImaging::exposure() const {
   return sensor_.physical() ? sensor_.next().exposure_s : scn_.uavs[uav_].camera.shutter.exposure;
@@ -72,12 +74,24 @@ bool CameraImaging::per_pixel() const {
 
 TakenFrame CameraImaging::retake(const sim::Truth& truth, double t, const Draw& draw) {
   if (!per_pixel()) throw std::logic_error("CameraImaging::retake: the camera's imaging has state of its own");
-  effects_ = effects_before_;
-  return take(truth, t, draw);
+  const auto at = std::find_if(effects_before_.begin(), effects_before_.end(),
+                               [&](const auto& e) { return std::abs(e.first - t) < 1e-9; });
+  if (at == effects_before_.end())
+    throw std::logic_error("CameraImaging::retake: no frame at t = " + std::to_string(t) + " among the last two");
+  const render::ImageEffects now = effects_;
+  effects_ = at->second;
+  TakenFrame f = draw_frame(truth, t, draw);
+  effects_ = now;
+  return f;
 }
 
 TakenFrame CameraImaging::take(const sim::Truth& truth, double t, const Draw& draw) {
-  effects_before_ = effects_;
+  effects_before_.emplace_back(t, effects_);
+  if (effects_before_.size() > 2) effects_before_.pop_front();
+  return draw_frame(truth, t, draw);
+}
+
+TakenFrame CameraImaging::draw_frame(const sim::Truth& truth, double t, const Draw& draw) {
   const sim::ShutterSpec& shutter = scn_.uavs[uav_].camera.shutter;
   const sim::KinematicState k = truth.camera(uav_, t);
   TakenFrame out;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -46,8 +47,9 @@ class CameraImaging {
   // Camera `uav`'s frame at time t, drawn over the exposure and readout with the motion of
   // true_poses() and the lead's own.
   TakenFrame take(const sim::Truth& truth, double t, const Draw& draw);
-  // The frame the last take() made, drawn again by `draw` with the same random draws of the
-  // image effects (a region frame that turned out to be needed whole). Only for per_pixel().
+  // The frame one of the last two take()s made at time t, drawn again by `draw` with the same
+  // random draws of the image effects (a region frame that turned out to be needed whole, or
+  // with more regions); later frames keep theirs. Only for per_pixel().
   TakenFrame retake(const sim::Truth& truth, double t, const Draw& draw);
   // A global shutter with no exposure time: one render at the frame's time, the same for every
   // run of a seed-free truth (a frame cache may hold it).
@@ -62,6 +64,7 @@ class CameraImaging {
   // The next frame's exposure time: the sensor's (auto-exposure's) when it is physical, the
   // shutter's otherwise.
   double exposure() const;
+  TakenFrame draw_frame(const sim::Truth& truth, double t, const Draw& draw);
 
   const sim::Scenario& scn_;
   int uav_;
@@ -69,7 +72,8 @@ class CameraImaging {
   std::optional<render::Haze> haze_;
   render::SensorModel sensor_;
   render::ImageEffects effects_;
-  render::ImageEffects effects_before_;  // as the last take() found them, for retake()
+  // The image effects as the last two take()s found them, with their times, for retake().
+  std::deque<std::pair<double, render::ImageEffects>> effects_before_;
 };
 
 }  // namespace wingman::app

@@ -19,9 +19,7 @@ FrameMeasurements::FrameMeasurements(const RunConfig& cfg, const sim::Truth& tru
       partial_(cam_uav_.size(), 0),
       now_(cam_uav_.size()),
       lead_(cam_uav_.size()) {
-  // Step k+1's regions are planned from step k's update: with regions, each camera's rendering
-  // overlaps the previous camera's detection instead.
-  prefetch_ = options.prefetch && frames_->renders() && !regions_;
+  prefetch_ = options.prefetch && frames_->renders();
   record_.enabled = true;
   record_.detector = frontend_.detector_name();
   record_.renderer = frames_->description();
@@ -62,67 +60,68 @@ StageTimes FrameMeasurements::begin_step(int k, double t, const slam::Estimator&
 }
 
 void FrameMeasurements::detect_all(StageTimes& st) {
-  for (int j = 0; j < frontend_.num_cameras(); ++j) st.detect_ms += frontend_.detect(j, now_[j].frame);
+  for (int j = 0; j < frontend_.num_cameras(); ++j) st.detect_ms += frontend_.detect(j, now_[j].frame, partial_[j]);
 }
 
-void FrameMeasurements::produce(int j, int k, double t, StageTimes& st) {
+bool FrameMeasurements::produce(int j, int k, double t, const std::optional<std::vector<cv::Rect>>& regions,
+                                CameraFrame& out) {
+  if (regions_ && regions && frames_->produce_regions(j, k, t, *regions, out)) return true;
+  frames_->produce(j, k, t, out);
+  return false;
+}
+
+namespace {
+
+// The rectangles of `wanted` (cut to the image) that `drawn` does not cover whole.
+std::vector<cv::Rect> not_drawn(const std::vector<cv::Rect>& wanted, const std::vector<cv::Rect>& drawn,
+                                cv::Size image) {
+  cv::Mat mask = cv::Mat::zeros(image, CV_8U);
+  const cv::Rect all(0, 0, image.width, image.height);
+  for (const cv::Rect& d : drawn) mask(d & all).setTo(1);
+  std::vector<cv::Rect> out;
+  for (const cv::Rect& w : wanted)
+    if (const cv::Rect c = w & all; !c.empty() && cv::countNonZero(mask(c)) < c.area()) out.push_back(c);
+  return out;
+}
+
+}  // namespace
+
+void FrameMeasurements::take_prefetched(int k, double t, StageTimes& st) {
   const auto t0 = io::Clock::now();
-  partial_[j] = 0;
-  if (regions_)
-    if (const auto r = frontend_.reads(j)) partial_[j] = frames_->produce_regions(j, k, t, *r, now_[j]);
-  if (!partial_[j]) frames_->produce(j, k, t, now_[j]);
+  for (int j = 0; j < frontend_.num_cameras(); ++j) {
+    now_[j] = std::move(next_.frames[j]);
+    partial_[j] = next_.drawn[j].has_value();
+    if (!partial_[j]) continue;
+    const auto wanted = frontend_.reads(j);
+    if (!wanted) {
+      frames_->produce_whole(j, k, t, now_[j]);
+      partial_[j] = 0;
+      ++record_.region_fills;
+    } else if (const auto missing = not_drawn(*wanted, *next_.drawn[j], now_[j].frame.rgb.size()); !missing.empty()) {
+      frames_->produce_more(j, k, t, missing, now_[j]);
+      ++record_.region_fills;
+    }
+  }
+  next_.k = -1;
   st.render_ms += io::ms_since(t0);
 }
 
-StageTimes FrameMeasurements::produce_and_detect(int k, double t, const slam::Estimator& est) {
-  StageTimes st;
-  const auto t_start = io::Clock::now();
-  frontend_.plan_step(est);  // before any camera detects, on whichever thread
+void FrameMeasurements::prefetch(int k, const slam::Estimator& est) {
   const int n = frontend_.num_cameras();
-  const bool ahead = prefetch_ && k < cfg_.num_steps();
-  const bool have = next_.k == k;  // produced during the previous step
-  if (have) {
-    for (int j = 0; j < n; ++j) now_[j] = std::move(next_.frames[j]);
-    next_.k = -1;
-  } else if (ahead) {
-    const auto t0 = io::Clock::now();
-    for (int j = 0; j < n; ++j) frames_->produce(j, k, t, now_[j]);
-    st.render_ms += io::ms_since(t0);
+  std::vector<std::optional<std::vector<cv::Rect>>> wanted(n);
+  if (regions_) {
+    slam::Estimator ahead = est;
+    ahead.predict(cfg_.dt());
+    wanted = frontend_.reads_for(ahead);
   }
-  if (have && !ahead) {  // the last step: nothing left to produce
-    detect_all(st);
-  } else if (ahead) {
-    // Step k's detection (the cameras one after the other: the extractor is not shared) on a
-    // second thread while this one, which holds the GL context, renders step k+1.
-    auto detection = std::async(std::launch::async, [this] {
-      StageTimes d;
-      detect_all(d);
-      return d.detect_ms;
-    });
-    const auto t0 = io::Clock::now();
-    next_.frames.resize(n);
-    for (int j = 0; j < n; ++j) frames_->produce(j, k + 1, (k + 1) * cfg_.dt(), next_.frames[j]);
-    next_.k = k + 1;
-    st.render_ms += io::ms_since(t0);
-    st.detect_ms += detection.get();
-  } else {
-    produce_and_detect_each(k, t, st);
-  }
-  st.wall_ms = io::ms_since(t_start);
-  return st;
+  next_.frames.resize(n);
+  next_.drawn.assign(n, std::nullopt);
+  for (int j = 0; j < n; ++j)
+    if (produce(j, k + 1, (k + 1) * cfg_.dt(), wanted[j], next_.frames[j])) next_.drawn[j] = wanted[j];
+  next_.k = k + 1;
 }
 
-// Camera j's detection runs on a second thread while camera j+1 is produced (the GL context stays
-// on this thread; two detections never run at once). A camera whose regions missed the lead gets
-// its whole frame and is detected again, as the whole-frame path would have searched it.
-void FrameMeasurements::produce_and_detect_each(int k, double t, StageTimes& st) {
-  std::future<double> pending;
-  for (int j = 0; j < frontend_.num_cameras(); ++j) {
-    produce(j, k, t, st);
-    if (pending.valid()) st.detect_ms += pending.get();
-    pending = std::async(std::launch::async, [this, j] { return frontend_.detect(j, now_[j].frame, partial_[j]); });
-  }
-  if (pending.valid()) st.detect_ms += pending.get();
+void FrameMeasurements::redo_whole(int k, double t, StageTimes& st) {
   for (int j = 0; j < frontend_.num_cameras(); ++j) {
     if (!frontend_.needs_whole_frame(j)) continue;
     const auto t0 = io::Clock::now();
@@ -133,6 +132,58 @@ void FrameMeasurements::produce_and_detect_each(int k, double t, StageTimes& st)
     ++record_.whole_frame_retries;
   }
   for (int j = 0; j < frontend_.num_cameras(); ++j) record_.region_frames += partial_[j];
+}
+
+StageTimes FrameMeasurements::produce_and_detect(int k, double t, const slam::Estimator& est) {
+  StageTimes st;
+  const auto t_start = io::Clock::now();
+  frontend_.plan_step(est);  // before any camera detects, on whichever thread
+  const int n = frontend_.num_cameras();
+  const bool ahead = prefetch_ && k < cfg_.num_steps();
+  if (!prefetch_) {
+    produce_and_detect_each(k, t, st);
+  } else {
+    if (next_.k == k) {  // produced during the previous step
+      take_prefetched(k, t, st);
+    } else {
+      const auto t0 = io::Clock::now();
+      for (int j = 0; j < n; ++j) partial_[j] = produce(j, k, t, frontend_.reads(j), now_[j]);
+      st.render_ms += io::ms_since(t0);
+    }
+    if (ahead) {
+      // Step k's detection (the cameras one after the other: the extractor is not shared) on a
+      // second thread while this one, which holds the GL context, renders step k+1.
+      auto detection = std::async(std::launch::async, [this] {
+        StageTimes d;
+        detect_all(d);
+        return d.detect_ms;
+      });
+      const auto t0 = io::Clock::now();
+      prefetch(k, est);
+      st.render_ms += io::ms_since(t0);
+      st.detect_ms += detection.get();
+    } else {
+      detect_all(st);
+    }
+    redo_whole(k, t, st);
+  }
+  st.wall_ms = io::ms_since(t_start);
+  return st;
+}
+
+// Camera j's detection runs on a second thread while camera j+1 is produced (the GL context stays
+// on this thread; two detections never run at once).
+void FrameMeasurements::produce_and_detect_each(int k, double t, StageTimes& st) {
+  std::future<double> pending;
+  for (int j = 0; j < frontend_.num_cameras(); ++j) {
+    const auto t0 = io::Clock::now();
+    partial_[j] = produce(j, k, t, frontend_.reads(j), now_[j]);
+    st.render_ms += io::ms_since(t0);
+    if (pending.valid()) st.detect_ms += pending.get();
+    pending = std::async(std::launch::async, [this, j] { return frontend_.detect(j, now_[j].frame, partial_[j]); });
+  }
+  if (pending.valid()) st.detect_ms += pending.get();
+  redo_whole(k, t, st);
 }
 
 Labelled<LandmarkObservation> FrameMeasurements::landmarks(int cam,

@@ -55,8 +55,17 @@ class FrameMeasurements final : public MeasurementSource {
   StageTimes produce_and_detect(int k, double t, const slam::Estimator& est);
   void detect_all(StageTimes& st);
   void produce_and_detect_each(int k, double t, StageTimes& st);
-  // Camera j's frame of step k: its frontend's regions where it reads only those, else whole.
-  void produce(int j, int k, double t, StageTimes& st);
+  // Camera j's frame of step k into `out`: `regions` alone where the producer can draw them so,
+  // else whole; returns whether it is regions.
+  bool produce(int j, int k, double t, const std::optional<std::vector<cv::Rect>>& regions, CameraFrame& out);
+  // Step k's frames, drawn during step k-1 from its predicted plan: the pixels this step's plan
+  // reads and they lack drawn now.
+  void take_prefetched(int k, double t, StageTimes& st);
+  // Step k+1's frames, from the plan of `est` predicted one step ahead (on this thread, which
+  // holds the GL context, while another detects step k).
+  void prefetch(int k, const slam::Estimator& est);
+  // Cameras whose regions missed the lead: their whole frame, detected again.
+  void redo_whole(int k, double t, StageTimes& st);
 
   const RunConfig& cfg_;
   const sim::Truth& truth_;
@@ -76,6 +85,7 @@ class FrameMeasurements final : public MeasurementSource {
   struct Prefetched {
     int k = -1;  // the step they belong to; -1: none
     std::vector<CameraFrame> frames;
+    std::vector<std::optional<std::vector<cv::Rect>>> drawn;  // per camera: its regions, or whole
   } next_;
   eval::FrontendRecord record_;
 };

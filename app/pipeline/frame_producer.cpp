@@ -64,6 +64,20 @@ bool RendererFrames::produce_regions(int cam, int, double t, const std::vector<c
   return true;
 }
 
+void RendererFrames::produce_more(int cam, int, double t, const std::vector<cv::Rect>& regions, CameraFrame& out) {
+  const TakenFrame f = imaging_[cam]->retake(
+      truth_, t, [&](const render::CameraView& view, const render::LeadPose& at, int, int) {
+        return renderer().render_regions(view, at, regions);
+      });
+  const cv::Rect image(0, 0, f.frame.rgb.cols, f.frame.rgb.rows);
+  for (const cv::Rect& r : regions) {
+    const cv::Rect c = r & image;
+    if (c.empty()) continue;
+    f.frame.rgb(c).copyTo(out.frame.rgb(c));
+    f.frame.depth(c).copyTo(out.frame.depth(c));
+  }
+}
+
 void RendererFrames::take(int cam, double t, const std::vector<cv::Rect>* regions, bool again, CameraFrame& out) {
   CameraImaging& imaging = *imaging_[cam];
   // The lead's label: its silhouette drawn alone at the frame's time (a small window, never cached).

@@ -43,8 +43,13 @@ class FrameProducer {
                                CameraFrame& /*out*/) {
     return false;
   }
-  // The frame produce_regions() last gave for `cam`, whole: the same frame, every pixel drawn.
+  // A frame produce_regions() gave for `cam` (of its last two), whole: the same frame, every pixel
+  // drawn.
   virtual void produce_whole(int cam, int k, double t, CameraFrame& out) { produce(cam, k, t, out); }
+  // The same, with only `regions` drawn into `out`, which holds that frame's other regions.
+  virtual void produce_more(int cam, int k, double t, const std::vector<cv::Rect>& /*regions*/, CameraFrame& out) {
+    produce_whole(cam, k, t, out);
+  }
   virtual std::string description() const = 0;
   // Whether step k+1 may be produced during step k (the renderer in open loop, whose truth is
   // known in advance).
@@ -75,6 +80,7 @@ class RendererFrames final : public FrameProducer {
   // (CameraImaging::per_pixel): the renderer's regions, and the lead label's window.
   bool produce_regions(int cam, int k, double t, const std::vector<cv::Rect>& regions, CameraFrame& out) override;
   void produce_whole(int cam, int k, double t, CameraFrame& out) override;
+  void produce_more(int cam, int k, double t, const std::vector<cv::Rect>& regions, CameraFrame& out) override;
   std::string description() const override;
   bool renders() const override { return true; }
   void finish(eval::FrontendRecord& rec) const override;

@@ -198,9 +198,10 @@ struct FrontendRecord {
   // Active search: the share of each frame's pixels the feature detector processed, summed over
   // the frames (1 per frame detected whole).
   double searched_fraction_sum = 0;
-  // Region rendering: frames of which only the frontend's regions were drawn, and of those the
-  // ones drawn again whole because the lead was not in its finder's window.
-  long region_frames = 0, whole_frame_retries = 0;
+  // Region rendering: frames of which only the frontend's regions were drawn; of those, the ones
+  // drawn again whole because the lead was not in its finder's window, and the prefetched ones
+  // whose step's own plan asked for pixels the predicted plan had not drawn.
+  long region_frames = 0, whole_frame_retries = 0, region_fills = 0;
   std::vector<double> lead_error_px;  // detection to true projection, for the lead_detected frames
   // Tracked correspondences the filter accepted: pixel to the landmark's true projection (NaN when
   // the landmark has no truth). Says whether the labelled outliers are near misses or mismatches.

@@ -190,7 +190,9 @@ void write_metrics_json(const Metrics& m, const RunRecord& run, const fs::path& 
                      {"accepted_error_histogram",
                       {{"bin_edges_px", FrontendMetrics::kErrorBins}, {"counts", f.accepted_error_histogram}}}};
     if (const FrontendRecord& r = run.frontend; r.region_frames > 0)
-      j["frame_regions"] = {{"frames", r.region_frames}, {"whole_frame_retries", r.whole_frame_retries}};
+      j["frame_regions"] = {{"frames", r.region_frames},
+                            {"whole_frame_retries", r.whole_frame_retries},
+                            {"filled_in", r.region_fills}};
     if (const FrameCacheRecord& c = run.frontend.frame_cache; c.used)
       j["frame_cache"] = {{"dir", c.dir},           {"hits", c.hits},
                           {"misses", c.misses},     {"corrupt", c.corrupt},

@@ -206,20 +206,34 @@ TEST(RenderedPipeline, PrefetchChangesTimingOnly) {
 }
 
 // Drawing only the pixels the frontend reads (its crops and the lead's window) changes the cost,
-// not the frames it reads: every figure is the whole-frame path's, and most frames were regions.
+// not the frames it reads: every figure is the whole-frame path's, with image noise too (a frame
+// drawn again, whole or with more regions, keeps its noise), whether step k+1 is drawn during
+// step k from a predicted plan (prefetch) or at its own step; and most frames were regions.
 TEST(RenderedPipeline, RegionRenderingChangesTimingOnly) {
   std::string why;
   if (!gl_available(&why)) WINGMAN_NO_GL_CONTEXT(why);
   app::RunConfig s = variant("multi");
   s.duration = 4;
-  RenderedOptions regions, whole;
+  s.world.image.noise_sigma = 3;
+  s.world.image.exposure_variation = 0.05;
+  RenderedOptions regions, regions_in_step, whole;
+  regions_in_step.prefetch = false;
   whole.regions = false;
-  const auto a = run_scenario(s, regions), b = run_scenario(s, whole);
-  expect_same_run(a, b);
+  const auto a = run_scenario(s, regions), b = run_scenario(s, whole), c = run_scenario(s, regions_in_step);
+  {
+    SCOPED_TRACE("regions, prefetched");
+    expect_same_run(a, b);
+  }
+  {
+    SCOPED_TRACE("regions at their step");
+    expect_same_run(c, b);
+  }
   EXPECT_EQ(b.frontend.region_frames, 0);
-  // The first steps (no map, no prediction of the lead) are whole; after them, regions.
-  EXPECT_GT(a.frontend.region_frames, a.frontend.frames / 2);
-  EXPECT_LT(a.frontend.whole_frame_retries, a.frontend.region_frames / 4);
+  for (const auto* r : {&a, &c}) {
+    EXPECT_GT(r->frontend.region_frames, r->frontend.frames / 2);
+    EXPECT_LT(r->frontend.whole_frame_retries, r->frontend.region_frames / 4);
+  }
+  EXPECT_EQ(c.frontend.region_fills, 0);  // planned at its own step: nothing to fill in
 }
 
 TEST(RenderedPipeline, MissingLeadModelIsAnErrorNamingTheFile) {
