@@ -2,7 +2,8 @@
 // frames through the vision frontend, labelled against the truth for evaluation, with the other
 // sensors (GPS, altimeter, range) from SensorSamples (measurements.hpp). Rendering and detection overlap on two
 // threads: camera j's detection with camera j+1's rendering, or, in open loop with prefetch, step
-// k's detection with step k+1's rendering; the results are the same either way.
+// k's detection with step k+1's rendering; the results are the same either way. With active
+// search only the pixels detection reads are drawn (VisionFrontend::reads), with the same results.
 #pragma once
 
 #include <memory>
