@@ -122,6 +122,30 @@ TEST(LeadDetector, SmallMarkerWithAPredictionIsFoundInTheUpscaledRegion) {
   EXPECT_LT((d->uv - centre).norm(), 1.0) << d->uv.transpose();
 }
 
+// The window-only search reads the window alone: the same detection as detect() when the marker
+// is in it, nothing when only the whole-image pass would find it; the pixels outside the window
+// do not matter.
+TEST(LeadDetector, TheWindowSearchReadsOnlyItsWindow) {
+  cv::Mat img = background();
+  const Vector2d centre(150.4, 350.9);
+  draw_marker(img, similarity(centre, 30, 0.3));
+  LeadDetector finder;
+  const Vector2d near = centre + Vector2d(20, -15), far(400, 100);
+  const auto window = finder.window(img.size(), near);
+  ASSERT_TRUE(window);
+  EXPECT_EQ(window->width, 2 * finder.settings().roi_half_px + 1);
+  cv::Mat only = cv::Mat::zeros(img.size(), img.type());
+  img(*window).copyTo(only(*window));
+  const auto whole = finder.detect(img, near), in_window = finder.detect_in_window(only, near);
+  ASSERT_TRUE(whole && in_window);
+  EXPECT_EQ(whole->uv, in_window->uv);
+  EXPECT_TRUE(finder.detect(img, far));             // found by the whole-image pass
+  EXPECT_FALSE(finder.detect_in_window(img, far));  // not in the window around the prediction
+  LeadDetectorSettings colour;
+  colour.method = LeadMethod::Colour;
+  EXPECT_FALSE(LeadDetector(colour).window(img.size(), near));  // a panel is searched over the image
+}
+
 TEST(LeadDetector, ColourFallbackFindsTheMagentaPanelCentroid) {
   cv::Mat img = background();
   LeadDetectorSettings s;
