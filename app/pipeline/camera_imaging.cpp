@@ -21,6 +21,10 @@ geometry::CameraPose pose_after(const sim::Truth& truth, int uav, double t, cons
 
 }  // namespace
 
+geometry::CameraPose true_centre_pose(const sim::Truth& truth, int uav, double t) {
+  return pose_after(truth, uav, t, truth.camera(uav, t), 0);
+}
+
 geometry::FramePoses true_poses(const sim::Scenario& scn, const sim::Truth& truth, int uav, double t) {
   const sim::CameraSpec& c = scn.uavs[uav].camera;
   const sim::KinematicState k = truth.camera(uav, t);

@@ -32,6 +32,8 @@ struct TakenFrame {
 // The poses camera `uav`'s frame at time t is taken from: the camera's state at t carried on at
 // constant acceleration over the readout (a fraction of a step), the gimbal's own rotation.
 geometry::FramePoses true_poses(const sim::Scenario& scn, const sim::Truth& truth, int uav, double t);
+// Their centre alone: the camera's pose at t (FramePoses::centre()), without the rows.
+geometry::CameraPose true_centre_pose(const sim::Truth& truth, int uav, double t);
 
 // The shutter and sensor a dataset's cam0/sensor.yaml records.
 void describe_shutter(const sim::CameraSpec& camera, datasets::CameraInfo& info);

@@ -82,8 +82,8 @@ void RendererFrames::take(int cam, double t, const std::vector<cv::Rect>* region
   CameraImaging& imaging = *imaging_[cam];
   // The lead's label: its silhouette drawn alone at the frame's time (a small window, never cached).
   const render::LeadPose lead = sim::lead_pose(truth_, t, cfg_.world);
-  const geometry::FramePoses poses = true_poses(cfg_, truth_, cam_uav_[cam], t);
-  const auto silhouette = renderer().lead_silhouette({imaging.model(), poses.centre()}, lead);
+  const auto silhouette =
+      renderer().lead_silhouette({imaging.model(), true_centre_pose(truth_, cam_uav_[cam], t)}, lead);
   std::vector<cv::Rect> drawn;
   if (regions) {
     drawn = *regions;
