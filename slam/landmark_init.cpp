@@ -94,17 +94,19 @@ std::pair<Eigen::MatrixXd, Eigen::MatrixXd> augmented_covariance(
   return {std::move(cross), std::move(cov)};
 }
 
-// A new landmark's parameters followed by the other cameras' pixel offsets (LandmarkSlot::
-// pixel_offset): zero, prior sigma^2 I, independent of the state and of the parameters.
+// A new landmark's parameters followed by the pixel offsets of the cameras in `cams`
+// (LandmarkSlot::pixel_offset): zero, prior sigma^2 I, independent of the state and of the
+// parameters.
 struct WithOffsets {
   Eigen::VectorXd value;
   Eigen::MatrixXd cross, cov;
 };
 WithOffsets append_pixel_offsets(const FilterState& s, const Eigen::VectorXd& value,
-                                 const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov, double sigma) {
-  const int b = static_cast<int>(value.size()), d = b + 2 * (s.num_cameras() - 1);
+                                 const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov,
+                                 const PixelOffsets& offsets) {
+  const int b = static_cast<int>(value.size()), d = b + 2 * std::popcount(offsets.cams);
   WithOffsets w{Eigen::VectorXd::Zero(d), Eigen::MatrixXd::Zero(d, s.dim()),
-                sigma * sigma * Eigen::MatrixXd::Identity(d, d)};
+                offsets.sigma * offsets.sigma * Eigen::MatrixXd::Identity(d, d)};
   w.value.head(b) = value;
   w.cross.topRows(b) = cross;
   w.cov.topLeftCorner(b, b) = cov;
@@ -148,17 +150,16 @@ InitOutcome initialise_cooperative(FilterState& s, int cam_a, const CameraRig& c
   if (!(noise.pixel_offset_sigma.value > 0)) return {s.add_landmark(LandmarkKind::Euclidean, t->point, cross, cov), ""};
 
   // With pixel offsets: the point was triangulated from uv_b - o_b with o_b ~ N(0, sigma^2 I), so
-  // d point / d o_b = -Jzb; the other cameras' offsets start independent of everything.
+  // d point / d o_b = -Jzb. Camera b's offsets are states from here on; the other cameras' are
+  // stated when they first observe the point.
   const double var = noise.pixel_offset_sigma.value * noise.pixel_offset_sigma.value;
-  auto w = append_pixel_offsets(s, t->point, cross, cov, noise.pixel_offset_sigma.value);
-  LandmarkSlot probe;  // where camera b's offset sits among the new parameters
-  probe.anchor_cam = cam_a;
-  probe.extra = static_cast<int>(w.value.size()) - 3;
-  const int ob = probe.pixel_offset(cam_b);  // probe.offset is 0: an index into value
+  const PixelOffsets offsets{cam_a, std::uint64_t{1} << cam_b, noise.pixel_offset_sigma.value};
+  auto w = append_pixel_offsets(s, t->point, cross, cov, offsets);
+  const int ob = 3;  // camera b's offsets, the only ones, right after the point
   w.cov.topLeftCorner<3, 3>() += var * Jzb * Jzb.transpose();
   w.cov.block<3, 2>(0, ob) = -var * Jzb;
   w.cov.block<2, 3>(ob, 0) = -var * Jzb.transpose();
-  return {s.add_landmark(LandmarkKind::Euclidean, w.value, w.cross, w.cov, cam_a), ""};
+  return {s.add_landmark(LandmarkKind::Euclidean, w.value, w.cross, w.cov, offsets), ""};
 }
 
 Vector6d inverse_depth_from_pixel(const CameraRig& cam, const Eigen::Vector3d& x_c,
@@ -199,9 +200,8 @@ InitOutcome initialise_inverse_depth(FilterState& s, int cam, const CameraRig& c
   const auto [cross, cov] = augmented_covariance(s, deps, pixel_cov);
   if (!(noise.pixel_offset_sigma.value > 0) || s.num_cameras() < 2)
     return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov), ""};
-  // The other cameras' offsets start at 0, independent of everything (this pixel has none).
-  const auto w = append_pixel_offsets(s, y, cross, cov, noise.pixel_offset_sigma.value);
-  return {s.add_landmark(LandmarkKind::InverseDepth, w.value, w.cross, w.cov, cam), ""};
+  // The other cameras' offsets are stated when they first observe it (this pixel has none).
+  return {s.add_landmark(LandmarkKind::InverseDepth, y, cross, cov, {cam, 0, noise.pixel_offset_sigma.value}), ""};
 }
 
 InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, const CameraRig& commanded_a,
@@ -213,6 +213,7 @@ InitOutcome initialise_cooperative_inverse_depth(FilterState& s, int cam_a, cons
                                                  double gate_probability) {
   InitOutcome r = initialise_inverse_depth(s, cam_a, commanded_a, uv_a, cfg, noise);
   if (!r.id) return r;
+  s.state_pixel_offsets({{*r.id, cam_b}});
   const LandmarkSlot* lm = s.find(*r.id);
   const int rho = lm->offset + 5;
   // One iterated-EKF step: camera b's projection is linearised at the pair's triangulated inverse

@@ -151,6 +151,8 @@ std::optional<Measurement> landmark_measurement(const FilterState& s, const Land
   if (const int o = lm.pixel_offset(cam_index); o >= 0) {  // uv = projection + this camera's offset
     m.h += s.x.segment<2>(o);
     m.blocks.push_back({o, Eigen::Matrix2d::Identity()});
+  } else {  // an offset not yet a state: zero mean, independent of everything, so noise
+    m.R.diagonal().array() += lm.unstated_offset_variance(cam_index);
   }
   return m;
 }

@@ -49,8 +49,9 @@ struct MeasurementNoiseSettings {
   // px, per axis. `auto` (the default): synthetic runs take the truth's noise.pixel_sigma (the
   // sensor's specification), rendered runs the frontend noise model's figure for the detector.
   geometry::AutoNumber pixel_sigma{3.0};
-  // > 0: every landmark carries each other camera's constant pixel offset from the camera that
-  // initialised it, prior sigma this (px per axis); 0: pixel errors are white. `auto`: synthetic
+  // > 0: every landmark carries, as states, the constant pixel offset from the camera that
+  // initialised it of each other camera once that camera observes it, prior sigma this (px per
+  // axis); 0: pixel errors are white. `auto`: synthetic
   // runs take sqrt(2) noise.pixel_bias_sigma (the difference of two cameras' offsets), rendered
   // runs the frontend noise model's.
   geometry::AutoNumber pixel_offset_sigma{0.0};

@@ -23,14 +23,18 @@ const LandmarkSlot* FilterState::find(LandmarkId id) const {
 
 LandmarkId FilterState::add_landmark(LandmarkKind kind, const Eigen::VectorXd& value,
                                      const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov,
-                                     int anchor_cam) {
+                                     const PixelOffsets& offsets) {
   const int n = dim();
   const int d = static_cast<int>(value.size());
-  if (anchor_cam >= num_cameras_)
+  if (offsets.anchor_cam >= num_cameras_ || (offsets.anchor_cam < 0 && offsets.cams != 0))
     throw std::invalid_argument("FilterState::add_landmark: anchor camera out of range");
-  const int extra = anchor_cam >= 0 ? 2 * (num_cameras_ - 1) : 0;
-  if (d != (kind == LandmarkKind::Euclidean ? 3 : 6) + extra || cross.rows() != d || cross.cols() != n ||
-      cov.rows() != d || cov.cols() != d)
+  const std::uint64_t all = num_cameras_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cameras_) - 1;
+  if ((offsets.cams & ~all) != 0 || (offsets.anchor_cam >= 0 && (offsets.cams >> offsets.anchor_cam & 1)))
+    throw std::invalid_argument("FilterState::add_landmark: offsets of a camera out of range or of the anchor");
+  if (offsets.anchor_cam >= 0 && num_cameras_ > 64)
+    throw std::invalid_argument("FilterState::add_landmark: pixel offsets for at most 64 cameras");
+  const int expected = (kind == LandmarkKind::Euclidean ? 3 : 6) + 2 * std::popcount(offsets.cams);
+  if (d != expected || cross.rows() != d || cross.cols() != n || cov.rows() != d || cov.cols() != d)
     throw std::invalid_argument("FilterState::add_landmark: inconsistent sizes");
   x.conservativeResize(n + d);
   x.tail(d) = value;
@@ -42,10 +46,57 @@ LandmarkId FilterState::add_landmark(LandmarkKind kind, const Eigen::VectorXd& v
   slot.id = next_id_++;
   slot.kind = kind;
   slot.offset = n;
-  slot.anchor_cam = anchor_cam;
-  slot.extra = extra;
+  slot.offsets = offsets;
   landmarks_.push_back(slot);
   return slot.id;
+}
+
+void FilterState::state_pixel_offsets(const std::vector<std::pair<LandmarkId, int>>& pairs) {
+  // New offsets per landmark (a camera asked for twice is stated once).
+  std::vector<std::uint64_t> adding(landmarks_.size(), 0);
+  int added = 0;
+  for (const auto& [id, cam] : pairs) {
+    const LandmarkSlot* lm = find(id);
+    if (!lm || cam >= num_cameras_ || !(lm->unstated_offset_variance(cam) > 0)) continue;
+    std::uint64_t& a = adding[lm - landmarks_.data()];
+    if (!(a >> cam & 1)) ++added;
+    a |= std::uint64_t{1} << cam;
+  }
+  if (added == 0) return;
+  // Runs of the old state that stay contiguous, and where each lands; the new offsets go
+  // between them, each camera's pair at its place in camera order within its landmark.
+  struct Run { int from, to, len; };
+  struct NewPair { int at; double var; };
+  std::vector<Run> runs;
+  std::vector<NewPair> fresh;
+  const int n = dim(), n_new = n + 2 * added;
+  int from = 0, shift = 0;
+  for (std::size_t i = 0; i < landmarks_.size(); ++i) {
+    LandmarkSlot& lm = landmarks_[i];
+    const int base_end = lm.offset + lm.base_dim();
+    lm.offset += shift;
+    for (std::uint64_t rest = adding[i]; rest != 0; rest &= rest - 1) {
+      const int cam = std::countr_zero(rest);
+      // Old index where camera cam's pair goes: after the stated ones of lower cameras.
+      const int at = base_end + 2 * std::popcount(lm.offsets.cams & ((std::uint64_t{1} << cam) - 1));
+      runs.push_back({from, from + shift, at - from});
+      fresh.push_back({at + shift, lm.offsets.sigma * lm.offsets.sigma});
+      from = at;
+      shift += 2;
+    }
+    lm.offsets.cams |= adding[i];
+  }
+  runs.push_back({from, from + shift, n - from});
+
+  Eigen::VectorXd x_new = Eigen::VectorXd::Zero(n_new);
+  Eigen::MatrixXd P_new = Eigen::MatrixXd::Zero(n_new, n_new);
+  for (const Run& c : runs) {
+    x_new.segment(c.to, c.len) = x.segment(c.from, c.len);
+    for (const Run& r : runs) P_new.block(r.to, c.to, r.len, c.len) = P.block(r.from, c.from, r.len, c.len);
+  }
+  for (const NewPair& f : fresh) P_new.block<2, 2>(f.at, f.at).diagonal().setConstant(f.var);
+  x = std::move(x_new);
+  P = std::move(P_new);
 }
 
 void FilterState::remove_landmark(LandmarkId id) {

@@ -4,11 +4,13 @@
 // as white noise, and optionally one acceleration every agent shares (after the gimbal angles: the
 // formation's common manoeuvre as a Gauss-Markov process). Landmarks are Euclidean (3 parameters,
 // eq. 2) or inverse depth (6 parameters [x0 y0 z0 theta phi rho], Montiel et al. 2006) for the
-// single-UAV baseline, either optionally followed by the other cameras' constant pixel offsets.
+// single-UAV baseline, either optionally followed by the constant pixel offsets of the other cameras that observed it.
 #pragma once
 
 #include <Eigen/Core>
+#include <bit>
 #include <cstdint>
+#include <utility>
 #include <optional>
 #include <vector>
 
@@ -20,25 +22,42 @@ using LandmarkId = geometry::LandmarkId;
 
 enum class LandmarkKind { Euclidean, InverseDepth };
 
+// A landmark's pixel offsets: the constant offset from the anchor camera's (the camera that
+// initialised it, whose own offset the point absorbs) at which each other camera's detector puts
+// the landmark's corner, the same way in every frame, so that it is not read as a disagreement
+// between the cameras' poses (docs/results.md, "Pixel errors that persist along a track").
+// A camera's two offsets become states when it first observes the landmark: until then they are
+// N(0, sigma^2 I) and independent of everything (nothing else depends on them), so stating them
+// then, with that prior, is exact, and the state does not carry every camera's offsets for every
+// landmark.
+struct PixelOffsets {
+  int anchor_cam = -1;        // -1: the landmark carries no pixel offsets
+  std::uint64_t cams = 0;     // bit c: camera c's offsets are states (in camera order)
+  double sigma = 0;           // prior std of each offset (px)
+};
+
 struct LandmarkSlot {
   LandmarkId id = -1;
   LandmarkKind kind = LandmarkKind::Euclidean;
   int offset = 0;  // index of its first parameter in x
-  // Optional pixel offsets after the point's parameters: two per camera other than the anchor
-  // (the camera that initialised it, whose own constant detector offset the point absorbs), so
-  // that a detector that puts the landmark's corner a little off in each camera, the same way in
-  // every frame, is not read as a disagreement between the cameras' poses (docs/results.md,
-  // "Pixel errors that persist along a track").
-  int anchor_cam = -1;
-  int extra = 0;
+  PixelOffsets offsets;  // the stated ones follow the point's parameters
   int base_dim() const { return kind == LandmarkKind::Euclidean ? 3 : 6; }
-  int dim() const { return base_dim() + extra; }
-  // Index in x of camera cam's two pixel offsets, or -1 (none: the anchor, or no offsets).
+  int dim() const { return base_dim() + 2 * std::popcount(offsets.cams); }
+  // Index in x of camera cam's two pixel offsets, or -1 (none: the anchor, not stated, or none).
   int pixel_offset(int cam) const {
-    if (extra == 0 || cam == anchor_cam || cam < 0) return -1;
-    const int k = cam < anchor_cam ? cam : cam - 1;
-    return 2 * k + 2 <= extra ? offset + base_dim() + 2 * k : -1;
+    if (!stated(cam)) return -1;
+    const std::uint64_t below = (std::uint64_t{1} << cam) - 1;
+    return offset + base_dim() + 2 * std::popcount(offsets.cams & below);
   }
+  // Variance of each of camera cam's offsets while they are not states (sigma^2: they are added
+  // to the pixel noise), or 0 (stated, the anchor, or no offsets).
+  double unstated_offset_variance(int cam) const {
+    if (offsets.anchor_cam < 0 || cam == offsets.anchor_cam || cam < 0 || stated(cam)) return 0;
+    return offsets.sigma * offsets.sigma;
+  }
+
+ private:
+  bool stated(int cam) const { return cam >= 0 && cam < 64 && (offsets.cams >> cam & 1) != 0; }
 };
 
 class FilterState {
@@ -70,10 +89,16 @@ class FilterState {
   const LandmarkSlot* find(LandmarkId id) const;
 
   // Appends a landmark (state augmentation, eq. 52): `value` its parameters, `cross` its
-  // covariance with the existing state (dim x n), `cov` its own covariance.
-  // With anchor_cam >= 0, value also holds 2 (num_cameras - 1) pixel offsets after the point.
+  // covariance with the existing state (dim x n), `cov` its own covariance. With
+  // offsets.anchor_cam >= 0, value also holds the offsets of the cameras in offsets.cams after
+  // the point, two per camera in camera order.
   LandmarkId add_landmark(LandmarkKind kind, const Eigen::VectorXd& value,
-                          const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov, int anchor_cam = -1);
+                          const Eigen::MatrixXd& cross, const Eigen::MatrixXd& cov,
+                          const PixelOffsets& offsets = {});
+  // States the pixel offsets of the (landmark, camera) pairs given that are not states yet:
+  // zero, with their prior sigma^2 I, independent of everything. One rebuild of x and P for all.
+  // Pairs whose landmark has no offsets, or whose camera is its anchor, are skipped.
+  void state_pixel_offsets(const std::vector<std::pair<LandmarkId, int>>& pairs);
   // Deletes a landmark's rows and columns.
   void remove_landmark(LandmarkId id);
   // Replaces an inverse-depth landmark by its Euclidean form: value xyz and J = d xyz / d y.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
+#include <utility>
 
 #include "geometry/chi2.hpp"
 #include "slam/ekf_update.hpp"
@@ -20,6 +22,26 @@ double gate_threshold(double probability, int dof) {
     last_thr = geometry::chi2_quantile(probability, dof);
   }
   return last_thr;
+}
+
+// The compatible candidates update the pixel offsets of their cameras: those not yet states
+// become states (exact: until now they were independent noise), and the measurements are built
+// again on the grown state.
+void state_offsets_of(FilterState& s, const std::vector<CameraRig>& cams,
+                      const std::vector<Correspondence>& candidates, const std::vector<int>& compatible,
+                      double sigma_px, std::vector<Measurement>& meas) {
+  std::vector<std::pair<LandmarkId, int>> unstated;
+  for (int i : compatible)
+    if (s.find(candidates[i].id)->unstated_offset_variance(candidates[i].cam) > 0)
+      unstated.emplace_back(candidates[i].id, candidates[i].cam);
+  if (unstated.empty()) return;
+  s.state_pixel_offsets(unstated);
+  for (int i : compatible) {
+    const auto& c = candidates[i];
+    auto m = landmark_measurement(s, *s.find(c.id), c.cam, cams[c.cam], c.uv, sigma_px);
+    if (!m) throw std::logic_error("state_offsets_of: a compatible measurement no longer projects");
+    meas[i] = std::move(*m);
+  }
 }
 }  // namespace
 
@@ -56,6 +78,7 @@ VisualUpdateResult update_with_correspondences(FilterState& s, const std::vector
     compatible.push_back(static_cast<int>(i));
   }
   res.compatible = static_cast<int>(compatible.size());
+  state_offsets_of(s, cams, candidates, compatible, sigma_px, meas);
   // One joint update of the companions with the chosen candidates; on failure nothing is accepted.
   auto joint_update = [&](const std::vector<int>& chosen) {
     std::vector<const Measurement*> batch = extra;

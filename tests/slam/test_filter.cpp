@@ -456,3 +456,67 @@ TEST(CooperativeInverseDepth, PixelOffTheEpipolarLineIsRejected) {
   EXPECT_EQ(est.state().dim(), dim);
   EXPECT_EQ(est.num_landmarks(), 0);
 }
+
+// A camera's pixel offsets for a landmark are stated when its first compatible observation
+// arrives. Until then they are zero-mean noise independent of everything, so the posterior is the
+// one a filter that carried them from the start would reach, and an incompatible observation
+// states nothing.
+TEST(Update, OffsetsStatedAtFirstObservationGiveTheSamePosteriorAsOffsetsCarriedFromTheStart) {
+  std::mt19937_64 rng(11);
+  FilterState s(3);
+  s.x.head(s.kinematic_dim()) << 0, 0, 0, 1, 0, 0, -3, 0, 15, 1, 0, 0, 0, 0, 16, 1, 0, 0, 3, 0, 15, 1, 0, 0;
+  std::uniform_real_distribution<double> u(-6, 6);
+  for (int i = 0; i < 12; ++i) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(5);
+    v.head<3>() << u(rng), u(rng), 0.05 * u(rng);
+    s.add_landmark(LandmarkKind::Euclidean, v, Eigen::MatrixXd::Zero(5, s.dim()),
+                   Eigen::MatrixXd::Identity(5, 5), {0, 0b10, 0.75});
+  }
+  s.P = random_spd(s.dim(), rng) * 0.01;
+  const std::vector<CameraRig> cams(3, nadir_rig());
+  std::vector<Correspondence> cands;
+  std::normal_distribution<double> noise(0, 0.5);
+  for (const auto& lm : s.landmarks())
+    for (int cam : {1, 2}) {
+      auto uv = predict_landmark_pixel(s, s.x, lm, cam, cams[cam]);
+      ASSERT_TRUE(uv);
+      cands.push_back({cam, lm.id, *uv + Eigen::Vector2d(noise(rng), noise(rng))});
+    }
+  cands[5].uv += Eigen::Vector2d(80, 60);  // camera 2 on landmark 2: far off, gated out
+
+  // Carried from the start: every landmark's camera-2 offsets are states before the update.
+  FilterState carried = s;
+  std::vector<std::pair<LandmarkId, int>> all;
+  for (const auto& lm : s.landmarks()) all.emplace_back(lm.id, 2);
+  carried.state_pixel_offsets(all);
+  // The prediction the frontend searches around carries the unstated offsets as noise.
+  for (const auto& lm : s.landmarks()) {
+    const auto m = landmark_measurement(s, lm, 2, cams[2], Eigen::Vector2d::Zero(), 1.0);
+    const auto mc = landmark_measurement(carried, *carried.find(lm.id), 2, cams[2], Eigen::Vector2d::Zero(), 1.0);
+    EXPECT_LT((innovation_covariance(s, *m) - innovation_covariance(carried, *mc)).norm(), 1e-12);
+  }
+
+  GatingSettings gating;
+  std::mt19937_64 r1(5), r2(5);
+  FilterState late = s;
+  const auto a = update_with_correspondences(late, cams, cands, gating, 1.0, r1);
+  const auto b = update_with_correspondences(carried, cams, cands, gating, 1.0, r2);
+  EXPECT_EQ(a.accepted, b.accepted);
+  EXPECT_FALSE(a.accepted[5]);
+  EXPECT_EQ(late.dim(), s.dim() + 2 * 11);  // the gated-out pair was not stated
+  EXPECT_EQ(late.find(s.landmarks()[2].id)->pixel_offset(2), -1);
+  // Compare on the late filter's layout: the carried filter's entries at the same slots.
+  std::vector<int> at;
+  for (int i = 0; i < s.agent_dim(); ++i) at.push_back(i);
+  for (const auto& lm : late.landmarks()) {
+    const LandmarkSlot& c = *carried.find(lm.id);
+    for (int i = 0; i < 3; ++i) at.push_back(c.offset + i);
+    for (int cam : {1, 2})
+      if (lm.pixel_offset(cam) >= 0) at.insert(at.end(), {c.pixel_offset(cam), c.pixel_offset(cam) + 1});
+  }
+  ASSERT_EQ(static_cast<int>(at.size()), late.dim());
+  const Eigen::VectorXd xc = carried.x(at);
+  const Eigen::MatrixXd Pc = carried.P(at, at);
+  EXPECT_LT((late.x - xc).norm(), 1e-9 * xc.norm());
+  EXPECT_LT((late.P - Pc).norm(), 1e-9 * Pc.norm());
+}

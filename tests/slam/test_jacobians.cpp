@@ -163,7 +163,7 @@ TEST_P(BuilderTest, MeasurementBuildersPlaceTheirBlocks) {
   Eigen::VectorXd with_offset(5);
   with_offset << -2, 1.5, 0.2, 0.7, -0.4;
   s.add_landmark(LandmarkKind::Euclidean, with_offset, Eigen::MatrixXd::Zero(5, s.dim()),
-                 Eigen::MatrixXd::Identity(5, 5), 0);
+                 Eigen::MatrixXd::Identity(5, 5), {0, 0b10, 0.75});
 
   auto dense = [&](const Measurement& m) {
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m.dim(), s.dim());
@@ -259,7 +259,7 @@ TEST_P(BuilderTest, CooperativeLandmarkWithPixelOffsetsCarriesTheirCovariance) {
   ASSERT_TRUE(initialise_cooperative(t, 0, rig, uv_a, 1, rig, uv_b, coop, noise).id);
   const LandmarkSlot& lm = t.landmarks().back();
   ASSERT_EQ(lm.dim(), 5);
-  ASSERT_EQ(lm.anchor_cam, 0);
+  ASSERT_EQ(lm.offsets.anchor_cam, 0);
   EXPECT_EQ(lm.pixel_offset(0), -1);
   const int o = lm.pixel_offset(1);
   ASSERT_EQ(o, lm.offset + 3);
