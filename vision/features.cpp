@@ -170,7 +170,7 @@ FeatureExtractor::FeatureExtractor(const FeatureSettings& settings) : cfg_(setti
 cv::Ptr<cv::Feature2D> FeatureExtractor::make_detector(int n, int orb_edge) const {
   switch (cfg_.kind) {
     case DetectorKind::Orb:
-      return cv::ORB::create(n, cfg_.orb_scale_factor, cfg_.orb_levels, orb_edge, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+      return cv::ORB::create(n, cfg_.orb_scale_factor, cfg_.orb_levels, orb_edge, 0, 2, cfg_.orb_score, 31,
                              cfg_.orb_fast_threshold);
     case DetectorKind::GfttOrb:
       return cv::GFTTDetector::create(n, cfg_.gftt_quality, cfg_.gftt_min_distance, 3, false);

@@ -32,6 +32,9 @@ struct FeatureSettings {
   int orb_fast_threshold = 12;   // lower than OpenCV's 20: rendered ground is often low-contrast
   int orb_levels = 4;            // pyramid levels (scale changes between UAVs are small)
   float orb_scale_factor = 1.2f;
+  // Which corner score ranks FAST's candidates: Harris's (OpenCV's default) or FAST's own, which
+  // skips the Harris pass but was no faster on the paper scene (docs/studies/speed.md).
+  cv::ORB::ScoreType orb_score = cv::ORB::HARRIS_SCORE;
   double akaze_threshold = 0.0005;
   double gftt_quality = 0.005, gftt_min_distance = 5.0;
   double sift_contrast = 0.02;
@@ -50,6 +53,7 @@ struct FeatureSettings {
       o("fast_threshold", orb_fast_threshold, geometry::ge(1));
       o("levels", orb_levels, geometry::in(1, 16));
       o("scale_factor", orb_scale_factor, geometry::in(1, 2, true, false));
+      o.choice("score", orb_score, {{"harris", cv::ORB::HARRIS_SCORE}, {"fast", cv::ORB::FAST_SCORE}});
     });
     v.section("akaze", [&](auto& a) { a("threshold", akaze_threshold, geometry::gt(0)); });
     v.section("sift", [&](auto& a) { a("contrast_threshold", sift_contrast, geometry::gt(0)); });

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <opencv2/features2d.hpp>
 #include <stdexcept>
@@ -168,4 +169,29 @@ TEST(Features, OrbKeypointsSeenAtDifferentLevelsAgreeWithTheGeometry) {
   }
   EXPECT_LT((across.e / across.n).norm(), 0.06) << across.n << " matches across levels";
   EXPECT_GE(pairs, 2);
+}
+
+// orb.score: FAST's own score ranks the corners by an integer about the threshold or above; Harris's
+// by its response, far below 1 on 8-bit grey. Both find the same kind of spread features.
+TEST(Features, OrbScoreChoosesTheCornerRanking) {
+  const test::PlaneScene scene;
+  const cv::Mat img = scene.render(test::view_at({0, 0, 15}));
+  for (const auto score : {cv::ORB::HARRIS_SCORE, cv::ORB::FAST_SCORE}) {
+    FeatureSettings s;
+    s.orb_score = score;
+    s.max_features = 500;
+    const Features f = FeatureExtractor(s).detect(img);
+    ASSERT_GE(f.size(), 300);
+    float lo = f.keypoints.front().response, hi = lo;
+    for (const auto& k : f.keypoints) {
+      lo = std::min(lo, k.response);
+      hi = std::max(hi, k.response);
+    }
+    if (score == cv::ORB::FAST_SCORE) {
+      EXPECT_GE(lo, static_cast<float>(s.orb_fast_threshold - 1));
+      for (const auto& k : f.keypoints) EXPECT_EQ(k.response, std::round(k.response));
+    } else {
+      EXPECT_LT(hi, 1.0f);
+    }
+  }
 }
