@@ -246,8 +246,8 @@ void BM_EkfStep(benchmark::State& state) { ekf_step(state, static_cast<int>(stat
 
 // The team-size axis: 2 to 8 cameras over the same 200-landmark map (each camera offers at most 40
 // correspondences), with white pixel noise (offsets 0) or with pixel offsets as states (offsets 1)
-// for every landmark and every other camera that sees it (a run's steady state). A single UAV has no cooperative initialisation:
-// docs/studies/team-size.md.
+// for every landmark and every other camera that sees it (a run's steady state). A single UAV has
+// no cooperative initialisation: docs/studies/team-size.md.
 void BM_EkfTeam(benchmark::State& state) {
   ekf_step(state, 200, static_cast<int>(state.range(0)), state.range(1) != 0);
 }

@@ -26,13 +26,15 @@ LandmarkId FilterState::add_landmark(LandmarkKind kind, const Eigen::VectorXd& v
                                      const PixelOffsets& offsets) {
   const int n = dim();
   const int d = static_cast<int>(value.size());
-  if (offsets.anchor_cam >= num_cameras_ || (offsets.anchor_cam < 0 && offsets.cams != 0))
+  if (offsets.anchor_cam >= num_cameras_)
     throw std::invalid_argument("FilterState::add_landmark: anchor camera out of range");
+  if (offsets.anchor_cam < 0 && offsets.cams != 0)
+    throw std::invalid_argument("FilterState::add_landmark: pixel offsets without an anchor camera");
+  if (offsets.anchor_cam >= 0 && num_cameras_ > 64)
+    throw std::invalid_argument("FilterState::add_landmark: pixel offsets for at most 64 cameras");
   const std::uint64_t all = num_cameras_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cameras_) - 1;
   if ((offsets.cams & ~all) != 0 || (offsets.anchor_cam >= 0 && (offsets.cams >> offsets.anchor_cam & 1)))
     throw std::invalid_argument("FilterState::add_landmark: offsets of a camera out of range or of the anchor");
-  if (offsets.anchor_cam >= 0 && num_cameras_ > 64)
-    throw std::invalid_argument("FilterState::add_landmark: pixel offsets for at most 64 cameras");
   const int expected = (kind == LandmarkKind::Euclidean ? 3 : 6) + 2 * std::popcount(offsets.cams);
   if (d != expected || cross.rows() != d || cross.cols() != n || cov.rows() != d || cov.cols() != d)
     throw std::invalid_argument("FilterState::add_landmark: inconsistent sizes");

@@ -4,14 +4,15 @@
 // as white noise, and optionally one acceleration every agent shares (after the gimbal angles: the
 // formation's common manoeuvre as a Gauss-Markov process). Landmarks are Euclidean (3 parameters,
 // eq. 2) or inverse depth (6 parameters [x0 y0 z0 theta phi rho], Montiel et al. 2006) for the
-// single-UAV baseline, either optionally followed by the constant pixel offsets of the other cameras that observed it.
+// single-UAV baseline, either optionally followed by the constant pixel offsets of the other
+// cameras that observed it.
 #pragma once
 
 #include <Eigen/Core>
 #include <bit>
 #include <cstdint>
-#include <utility>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "geometry/pose.hpp"
