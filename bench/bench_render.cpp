@@ -5,9 +5,9 @@
 // Beside them the floor (BM_FloorEgl, BM_FloorOsMesa): one textured quad filling the same
 // 1000 x 1000 frame, drawn and read back as colour + metric depth through the same Renderer, so
 // that a scene's time over the floor's is the renderer's cost over what the machine and its GL
-// allow, one ratio that holds on any machine.
+// allow, one ratio that holds on any machine. Stages beside them: region rendering (BM_RegionsEgl)
+// and the readback alone per format (BM_ReadbackEgl).
 #include <benchmark/benchmark.h>
-
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -17,11 +17,13 @@
 #include <random>
 #include <vector>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 
 #include "app/pipeline/camera_imaging.hpp"
 #include "bench/process_cpu.hpp"
 #include "render/gl_context.hpp"
+#include "render/gl_functions.hpp"
 #include "render/renderer.hpp"
 #include "render/scene.hpp"
 #include "sim/scenario.hpp"
@@ -166,6 +168,74 @@ void BM_FloorEgl(benchmark::State& s) { render_floor(s, render::GlBackend::Egl);
 void BM_FloorOsMesa(benchmark::State& s) { render_floor(s, render::GlBackend::OsMesa); }
 BENCHMARK(BM_FloorEgl)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FloorOsMesa)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The readback stage alone: a 1000 x 1000 framebuffer cleared and read into memory, per format,
+// to price what a lighter frame would save against the floor. Argument: 0 the renderer's colour
+// (an RGBA8 buffer read as GL_RGBA, then RGBA to RGB and RGB to grey on the CPU, what a run
+// does), 1 the same buffer read as GL_RED (the format mismatches the buffer's), 2 an R8 buffer
+// read as GL_RED (a grey target), 3 the 32-bit float depth buffer read as GL_FLOAT, 4 path 0
+// through a pixel buffer object (read into the buffer, mapped, converted from the mapping).
+void readback(benchmark::State& state) {
+  const auto ctx = context_or_skip(state, render::GlBackend::Egl);
+  if (!ctx) return;
+  ctx->make_current();
+  render::GlFunctions gl;
+  gl.load(*ctx);
+  const int w = 1000, h = 1000, path = static_cast<int>(state.range(0));
+  GLuint fbo = 0, rb = 0;
+  gl.GenFramebuffers(1, &fbo);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+  gl.GenRenderbuffers(1, &rb);
+  gl.BindRenderbuffer(GL_RENDERBUFFER, rb);
+  const bool depth = path == 3, pbo = path == 4;
+  gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, 0, depth ? GL_DEPTH_COMPONENT32F : path == 2 ? GL_R8 : GL_RGBA8,
+                                    w, h);
+  gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, depth ? GL_DEPTH_ATTACHMENT : GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb);
+  if (depth) {
+    const GLenum none = GL_NONE;
+    gl.DrawBuffers(1, &none);
+    gl.ReadBuffer(GL_NONE);
+  } else {
+    gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  }
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  const auto map = reinterpret_cast<PFNGLMAPBUFFERRANGEPROC>(ctx->proc_address("glMapBufferRange"));
+  const auto unmap = reinterpret_cast<PFNGLUNMAPBUFFERPROC>(ctx->proc_address("glUnmapBuffer"));
+  GLuint buffer = 0;
+  if (pbo) {
+    gl.GenBuffers(1, &buffer);
+    gl.BindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
+    gl.BufferData(GL_PIXEL_PACK_BUFFER, 4 * w * h, nullptr, GL_STREAM_READ);
+  }
+  cv::Mat out(h, w, path == 0 || pbo ? CV_8UC4 : depth ? CV_32F : CV_8U), rgb, grey;
+  const float clear[4] = {0.25f, 0.5f, 0.75f, 1.f}, one = 0.5f;
+  const GLenum format = path == 0 || pbo ? GL_RGBA : depth ? GL_DEPTH_COMPONENT : GL_RED;
+  const GLenum type = depth ? GL_FLOAT : GL_UNSIGNED_BYTE;
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) {
+    if (depth) gl.ClearBufferfv(GL_DEPTH, 0, &one);
+    else gl.ClearBufferfv(GL_COLOR, 0, clear);
+    gl.ReadPixels(0, 0, w, h, format, type, pbo ? nullptr : out.data);
+    if (pbo) {
+      const cv::Mat mapped(h, w, CV_8UC4, map(GL_PIXEL_PACK_BUFFER, 0, 4 * w * h, GL_MAP_READ_BIT));
+      cv::cvtColor(mapped, rgb, cv::COLOR_RGBA2RGB);
+      unmap(GL_PIXEL_PACK_BUFFER);
+      cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+    } else if (path == 0) {
+      cv::cvtColor(out, rgb, cv::COLOR_RGBA2RGB);
+      cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+    }
+    benchmark::DoNotOptimize(out.data);
+  }
+  state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
+  if (gl.GetError() != GL_NO_ERROR) state.SkipWithError("OpenGL error while reading back");
+  if (pbo) gl.DeleteBuffers(1, &buffer);
+  gl.DeleteFramebuffers(1, &fbo);
+  gl.DeleteRenderbuffers(1, &rb);
+  state.SetLabel(ctx->description());
+}
+void BM_ReadbackEgl(benchmark::State& s) { readback(s); }
+BENCHMARK(BM_ReadbackEgl)->DenseRange(0, 4)->ArgName("path")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_RenderEgl(benchmark::State& s) { render_paper_camera(s, render::GlBackend::Egl); }
 void BM_RegionsEgl(benchmark::State& s) { render_paper_regions(s); }
