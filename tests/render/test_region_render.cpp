@@ -1,6 +1,6 @@
 // Region rendering: only the pixels inside a frame's regions are drawn and read back, under a
 // scissor rectangle with the whole frame's projection, so they are the whole frame's pixels there
-// (the chunks of the scene outside a region skipped).
+// (the chunks of the scene outside a region skipped, a box's pixels outside its regions masked).
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
@@ -52,31 +52,45 @@ Scene textured_scene(int msaa) {
 
 class RegionRenderTest : public ::testing::TestWithParam<GlBackend> {};
 
+// Four regions inside, on the border, and partly outside the image (clipped to it); 40 small
+// squares scattered over it, which the renderer draws in fewer boxes whose other pixels the depth
+// buffer masks; thin bars that cross, each its own draw over part of another's region; and a bar
+// drawn first, then two squares drawn as one box that crosses it.
+std::vector<std::vector<cv::Rect>> region_sets() {
+  std::vector<cv::Rect> scattered;
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> x(-10, 310), y(-10, 230), side(6, 30);
+  for (int i = 0; i < 40; ++i) scattered.emplace_back(x(rng), y(rng), side(rng), side(rng));
+  return {{{40, 30, 64, 48}, {150, 100, 33, 57}, {0, 200, 90, 40}, {290, -10, 60, 50}},
+          scattered,
+          {{10, 20, 250, 8}, {30, 5, 8, 220}, {200, 100, 110, 6}, {220, 60, 6, 150}},
+          {{0, 130, 320, 3}, {100, 100, 20, 20}, {140, 140, 20, 20}}};
+}
+
 TEST_P(RegionRenderTest, ARegionsPixelsAreTheWholeFramesAndTheRestIsZero) {
   WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
   const geometry::PinholeCamera cam(210.3, 190.7, 161.3, 118.6, 320, 240);
   const CameraView view{cam, {geometry::nadir_R_CW(), {0.37, -0.21, 20}}};
-  // Inside, on the border, and partly outside the image (clipped to it).
-  const std::vector<cv::Rect> regions = {{40, 30, 64, 48}, {150, 100, 33, 57}, {0, 200, 90, 40},
-                                         {290, -10, 60, 50}};
   for (const int msaa : {1, 4}) {
-    SCOPED_TRACE("msaa " + std::to_string(msaa));
     Renderer r(ctx, textured_scene(msaa));
     const Frame whole = r.render(view);
-    const Frame part = r.render_regions(view, std::nullopt, regions);
-    ASSERT_EQ(part.rgb.size(), whole.rgb.size());
-    cv::Mat inside = cv::Mat::zeros(whole.rgb.size(), CV_8U);
-    for (const cv::Rect& reg : regions) {
-      const cv::Rect c = reg & cv::Rect(0, 0, cam.width(), cam.height());
-      inside(c).setTo(255);
-      EXPECT_EQ(cv::norm(part.rgb(c), whole.rgb(c), cv::NORM_INF), 0) << "region " << reg << " on " << ctx.description();
-      EXPECT_EQ(cv::norm(part.depth(c), whole.depth(c), cv::NORM_INF), 0) << "region " << reg;
-    }
     EXPECT_GT(cv::norm(whole.rgb, cv::NORM_INF), 100);  // the texture is there
-    cv::Mat outside;
-    cv::bitwise_not(inside, outside);
-    EXPECT_EQ(cv::norm(part.rgb, cv::NORM_INF, outside), 0);
-    EXPECT_EQ(cv::norm(part.depth, cv::NORM_INF, outside), 0);
+    for (const auto& regions : region_sets()) {
+      SCOPED_TRACE("msaa " + std::to_string(msaa) + ", " + std::to_string(regions.size()) + " regions");
+      const Frame part = r.render_regions(view, std::nullopt, regions);
+      ASSERT_EQ(part.rgb.size(), whole.rgb.size());
+      cv::Mat inside = cv::Mat::zeros(whole.rgb.size(), CV_8U);
+      for (const cv::Rect& reg : regions) {
+        const cv::Rect c = reg & cv::Rect(0, 0, cam.width(), cam.height());
+        inside(c).setTo(255);
+        EXPECT_EQ(cv::norm(part.rgb(c), whole.rgb(c), cv::NORM_INF), 0) << "region " << reg << " on " << ctx.description();
+        EXPECT_EQ(cv::norm(part.depth(c), whole.depth(c), cv::NORM_INF), 0) << "region " << reg;
+      }
+      cv::Mat outside;
+      cv::bitwise_not(inside, outside);
+      EXPECT_EQ(cv::norm(part.rgb, cv::NORM_INF, outside), 0);
+      EXPECT_EQ(cv::norm(part.depth, cv::NORM_INF, outside), 0);
+    }
     EXPECT_EQ(cv::countNonZero(r.render_regions(view, std::nullopt, {}).depth), 0);  // no region: nothing
   }
 }
