@@ -653,13 +653,18 @@ struct Renderer::Impl {
     return targets.emplace(std::make_pair(w, h), std::move(t)).first->second;
   }
 
-  // Under scissor rectangle `box`: the depth buffer made to reject every fragment (the near
-  // plane's depth, the test strict) but in the regions that meet the box, which get the usual
-  // clear. A rejected fragment is not shaded; a region's pixels are drawn as in the whole frame.
-  void mask_outside(const cv::Rect& box, const std::vector<cv::Rect>& regions) {
+  // The depth buffer cleared under scissor rectangle `box` (the whole frame: regions null). With
+  // regions, made to reject every fragment (the near plane's depth, the test strict) but in the
+  // regions that meet the box, which get the usual clear: a rejected fragment is not shaded, and
+  // a region's pixels are drawn as in the whole frame.
+  void clear_depth(const cv::Rect& box, const std::vector<cv::Rect>* regions) {
+    if (!regions) {
+      gl.ClearBufferfv(GL_DEPTH, 0, &depth.clear);
+      return;
+    }
     const float reject = depth.reversed ? 1.f : 0.f;
     gl.ClearBufferfv(GL_DEPTH, 0, &reject);
-    for (const cv::Rect& r : regions)
+    for (const cv::Rect& r : *regions)
       if (const cv::Rect c = r & box; !c.empty()) {
         gl.Scissor(c.x, c.y, c.width, c.height);
         gl.ClearBufferfv(GL_DEPTH, 0, &depth.clear);
@@ -950,8 +955,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
     gl.BindFramebuffer(GL_FRAMEBUFFER, t.samples > 1 ? t.ms_fbo : t.fbo);
     if (t.samples > 1) gl.Enable(GL_MULTISAMPLE);
     gl.ClearBufferfv(GL_COLOR, 0, sky);
-    if (regions) I.mask_outside(r, regions->read);
-    else gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
+    I.clear_depth(r, regions ? &regions->read : nullptr);
     I.draw_scene(true, P, V, lead_model, light ? &*light : nullptr);
     if (t.samples > 1) {
       // Colour: the samples averaged by the blit. Depth: a single-sample pass (kDepthVs).
@@ -960,8 +964,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
       gl.BlitFramebuffer(r.x, r.y, r.x + r.width, r.y + r.height, r.x, r.y, r.x + r.width, r.y + r.height,
                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
       gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-      if (regions) I.mask_outside(r, regions->read);
-      else gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
+      I.clear_depth(r, regions ? &regions->read : nullptr);
       gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
       I.draw_scene(false, P, V, lead_model);
       gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -1121,7 +1124,7 @@ constexpr double kDrawCostPx = 9000;
 
 // Rectangles to draw that cover the regions: two are drawn as their bounding box whenever that
 // costs no more than drawing them apart, until no pair does (greedy, the largest saving first).
-// A box's pixels outside the regions are masked (Impl::mask_outside) but priced as drawn ones:
+// A box's pixels outside the regions are masked (Impl::clear_depth) but priced as drawn ones:
 // pricing them at 0.07 to 0.6 of a drawn pixel merged more and measured slower in BM_RegionsEgl.
 std::vector<cv::Rect> draw_rectangles(std::vector<cv::Rect> rects) {
   for (;;) {
