@@ -318,20 +318,24 @@ void quality_sweep(benchmark::State& state, render::GlBackend backend) {
 
 // The camera effects (sim/camera_sensor.hpp) on one 1000 x 1000 camera of
 // scenes/paper_rendered_fast.yaml (MSAA 1, anisotropy 1) at t = 20 s, through the imaging chain
-// the runs use (app/pipeline/camera_imaging.hpp). Argument: 0 ideal, 1 exposure blur (9 images),
-// 2 rolling shutter exact (every row its own pose), 3 rolling shutter in bands of 10 rows,
-// 4 physical sensor with auto-exposure, 5 all of them (bands of 10, 5 images, physical sensor),
-// 6 the sun's shadows (a 2048 px shadow map each frame), 7 the ground by repeat tiling (one
-// lookup where the default stochastic tiling takes three), 8 the clear-sky light model.
+// the runs use (app/pipeline/camera_imaging.hpp). Argument: 0 ideal; 1 a 10 ms exposure (as many
+// images as the image motion needs, at most 9); 2 rolling shutter, every row drawn alone (the
+// reference); 3 rolling shutter in bands of 10 rows; 4 physical sensor with auto-exposure; 5 all of
+// them at their defaults (rolling shutter in one pass, the exposure's images by the image motion,
+// physical sensor); 6 the sun's shadows (a 2048 px shadow map each frame); 7 the ground by repeat
+// tiling (one lookup where the default stochastic tiling takes three); 8 the clear-sky light
+// model; 9 all of them with the sun's shadows; 10 rolling shutter in one pass; 11 a 10 ms exposure
+// of 9 images always (the reference).
 void set_camera_effect(sim::CameraSpec& c, int effect) {
   using S = sim::ShutterSpec;
-  if (effect == 1 || effect == 5) c.shutter.exposure = 0.01, c.shutter.subframes = effect == 1 ? 9 : 5;
-  if (effect == 2 || effect == 3 || effect == 5) {
+  if (effect == 1 || effect == 5 || effect == 9 || effect == 11) c.shutter.exposure = 0.01, c.shutter.subframes = 9;
+  if (effect == 11) c.shutter.subframe_motion_px = 0;
+  if (effect == 2 || effect == 3 || effect == 5 || effect == 9 || effect == 10) {
     c.shutter.type = S::Type::Rolling;
     c.shutter.line_delay = 3e-5;
-    c.shutter.rows_per_band = effect == 2 ? 1 : 10;
+    c.shutter.rows_per_band = effect == 2 ? 1 : effect == 3 ? 10 : 0;
   }
-  if (effect == 4 || effect == 5) {
+  if (effect == 4 || effect == 5 || effect == 9) {
     c.sensor.model = sim::SensorSpec::Model::Physical;
     c.sensor.auto_exposure.enabled = true;
     c.sensor.vignetting = 0.5;
@@ -341,10 +345,11 @@ void set_camera_effect(sim::CameraSpec& c, int effect) {
 
 void camera_effect(benchmark::State& state, render::GlBackend backend) {
   sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_rendered_fast.yaml").front();
-  set_camera_effect(scn.uavs[0].camera, static_cast<int>(state.range(0)));
-  scn.world.light.shadows = state.range(0) == 6;
-  if (state.range(0) == 7) scn.world.texture.tiling = sim::TextureSpec::Tiling::Repeat;
-  if (state.range(0) == 8) scn.world.light.skylight.model = sim::SkylightSpec::Model::ClearSky;
+  const int effect = static_cast<int>(state.range(0));
+  set_camera_effect(scn.uavs[0].camera, effect);
+  scn.world.light.shadows = effect == 6 || effect == 9;
+  if (effect == 7) scn.world.texture.tiling = sim::TextureSpec::Tiling::Repeat;
+  if (effect == 8) scn.world.light.skylight.model = sim::SkylightSpec::Model::ClearSky;
   const auto ctx = context_or_skip(state, backend);
   if (!ctx) return;
   render::Renderer renderer(*ctx, render::build_scene(sim::describe_world(scn)));
@@ -364,7 +369,7 @@ void camera_effect(benchmark::State& state, render::GlBackend backend) {
 }
 
 void BM_CameraEffectEgl(benchmark::State& s) { camera_effect(s, render::GlBackend::Egl); }
-BENCHMARK(BM_CameraEffectEgl)->DenseRange(0, 8)->ArgName("effect")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_CameraEffectEgl)->DenseRange(0, 11)->ArgName("effect")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_QualitySweepEgl(benchmark::State& s) { quality_sweep(s, render::GlBackend::Egl); }
 // Arguments as BM_RenderEgl's. One iteration: 24 frames per setting.

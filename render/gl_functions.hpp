@@ -29,7 +29,8 @@ namespace wingman::render {
   X(PFNGLDELETEPROGRAMPROC, DeleteProgram) X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)   \
   X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv) X(PFNGLUNIFORMMATRIX3FVPROC, UniformMatrix3fv) \
   X(PFNGLUNIFORM3FVPROC, Uniform3fv) X(PFNGLUNIFORM1FPROC, Uniform1f)                           \
-  X(PFNGLUNIFORM2FVPROC, Uniform2fv) X(PFNGLUNIFORM1UIPROC, Uniform1ui)                        \
+  X(PFNGLUNIFORM2FVPROC, Uniform2fv) X(PFNGLUNIFORM4FVPROC, Uniform4fv)                         \
+  X(PFNGLUNIFORM1UIPROC, Uniform1ui)                                                            \
   X(PFNGLUNIFORM1IPROC, Uniform1i) X(PFNGLGENTEXTURESPROC, GenTextures)                         \
   X(PFNGLBINDTEXTUREPROC, BindTexture) X(PFNGLTEXIMAGE2DPROC, TexImage2D)                       \
   X(PFNGLTEXPARAMETERIPROC, TexParameteri) X(PFNGLTEXPARAMETERFPROC, TexParameterf)             \

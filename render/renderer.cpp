@@ -3,11 +3,13 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "render/gl_functions.hpp"
@@ -26,7 +28,6 @@ layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 layout(location = 3) in vec3 a_colour;
-uniform mat4 u_model_view;
 uniform mat4 u_proj;
 uniform mat3 u_model_rot;
 uniform vec3 u_to_light;
@@ -49,7 +50,7 @@ void main() {
   vec3 shade = u_unlit ? vec3(1.0) : sky(n) + u_diffuse * max(dot(n, u_to_light), 0.0);
   v_uv = a_uv;
   v_colour = a_colour * shade;
-  gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
+  gl_Position = u_proj * eye(a_pos);
 }
 )";
 
@@ -86,7 +87,7 @@ void main() {
   v_ambient = a_colour * (u_unlit ? vec3(1.0) : sky(n));
   v_direct = a_colour * direct;
   v_light = u_light_from_model * vec4(a_pos, 1.0);
-  gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
+  gl_Position = u_proj * eye(a_pos);
 }
 )";
 
@@ -172,12 +173,58 @@ vec3 surface(vec2 uv) {
 // program (no colour, no texture): the surface at the pixel centre, exactly as without MSAA, never
 // a blend of two surfaces at an edge. Colour is resolved by glBlitFramebuffer. On llvmpipe this
 // costs 12 ms less than one resolve shader averaging the colour samples and picking a depth.
-const char* kDepthVs = R"(
+const char* kDepthInputs = R"(
 layout(location = 0) in vec3 a_pos;
-uniform mat4 u_model_view;
 uniform mat4 u_proj;
+)";
+
+const char* kDepthVs = R"(
 void main() {
-  gl_Position = u_proj * (u_model_view * vec4(a_pos, 1.0));
+  gl_Position = u_proj * eye(a_pos);
+}
+)";
+
+// A vertex's camera-frame position (every vertex shader's eye()): one model-view for the draw.
+const char* kOneViewEye = R"(
+uniform mat4 u_model_view;
+vec4 eye(vec3 p) { return u_model_view * vec4(p, 1.0); }
+)";
+
+// The same under a rolling shutter drawn in one pass (CameraView::rows): each knot's model-view
+// is three texels of u_knots (row `u_group`: the static scene, the lead, each body); a vertex
+// takes the model-view interpolated at the image row it lands on, found by fixed-point steps from
+// the middle knot (each step moves the row by the image's speed across rows times the line delay,
+// a small fraction of a pixel per pixel, so four steps leave no visible error). The row is the
+// image's (lens distortion applied), not the canvas's a distorted camera is drawn on.
+const char* kRollingEye = R"(
+uniform sampler2D u_knots;   // RGBA32F: knot k's model-view rows 0-2 at texels 3k .. 3k + 2
+uniform int u_group;
+uniform vec4 u_row_of;       // fy, cy, rows between knots, the last knot's index
+uniform vec4 u_dist;         // k1, k2, p1, p2
+uniform float u_k3;
+vec4 at_knot(int k, vec4 p) {
+  return vec4(dot(texelFetch(u_knots, ivec2(3 * k, u_group), 0), p),
+              dot(texelFetch(u_knots, ivec2(3 * k + 1, u_group), 0), p),
+              dot(texelFetch(u_knots, ivec2(3 * k + 2, u_group), 0), p), 1.0);
+}
+float image_row(vec4 e) {
+  vec2 x = clamp(e.xy / max(e.z, 1e-4), vec2(-10.0), vec2(10.0));  // behind the camera: off the image
+  float r2 = dot(x, x);
+  float radial = 1.0 + r2 * (u_dist.x + r2 * (u_dist.y + r2 * u_k3));
+  float y = x.y * radial + u_dist.z * (r2 + 2.0 * x.y * x.y) + 2.0 * u_dist.w * x.x * x.y;
+  return u_row_of.x * y + u_row_of.y;
+}
+vec4 eye(vec3 pos) {
+  vec4 p = vec4(pos, 1.0);
+  float last = u_row_of.w, k = 0.5 * last;
+  vec4 e;
+  for (int i = 0; i < 4; ++i) {
+    float kf = clamp(k, 0.0, last);
+    int k0 = min(int(kf), int(last) - 1);
+    e = mix(at_knot(k0, p), at_knot(k0 + 1, p), kf - float(k0));
+    k = image_row(e) / u_row_of.z;
+  }
+  return e;
 }
 )";
 
@@ -268,14 +315,37 @@ struct GpuMaterial {
   GLuint pieces = 0;  // the piece table's texture
 };
 
+// The uniform locations of kRollingEye; -1 in a program without it.
+struct RollingUniforms {
+  GLint knots = -1, group = -1, row_of = -1, dist = -1, k3 = -1;
+};
+
 // The uniform locations of one colour program; -1 for those it lacks (glUniform ignores them).
 struct ColourProgram {
   GLuint id = 0;
+  RollingUniforms roll;
   GLint model_view = -1, proj = -1, model_rot = -1, tex = -1, to_light = -1, ambient = -1, bounce = -1,
         diffuse = -1, unlit = -1;
   GLint light_from_model = -1, shadow = -1, zero_to_one = -1, model = -1, cloud_tex = -1, cloud_offset = -1,
         cloud_period = -1, cloud_height = -1, cloud_block = -1;
   GLint cell = -1, aspect = -1, sharpness = -1, mean = -1, pieces = -1;
+};
+
+struct DepthProgram {
+  GLuint id = 0;
+  GLint model_view = -1, proj = -1;
+  RollingUniforms roll;
+};
+
+// A rolling shutter's frame being drawn in one pass (CameraView::rows): the knots' model-views
+// per group of meshes (0 the static scene, 1 the lead, 2 + i body i), on the GPU as kRollingEye's
+// u_knots.
+struct RollingFrame {
+  bool on = false;
+  GLuint tex = 0;
+  std::vector<std::vector<Eigen::Matrix4d>> model_view;  // [group][knot]
+  Eigen::Vector4f row_of = Eigen::Vector4f::Zero(), dist = Eigen::Vector4f::Zero();
+  float k3 = 0;
 };
 
 struct Target {
@@ -329,10 +399,15 @@ cv::Mat Frame::gray() const {
 
 struct Renderer::Impl {
   GlFunctions gl;
-  GLuint depth_program = 0, white = 0;
-  GLint d_model_view = -1, d_proj = -1;
-  // The colour programs by [shadowed][stochastic]; id 0 where the scene needs none.
-  ColourProgram colour[2][2];
+  GLuint white = 0;
+  // The depth-only program, with one view or a rolling shutter's (made at its first frame).
+  DepthProgram depth_program[2];
+  // The colour programs by [rolling][shadowed][stochastic]; id 0 where the scene needs none (the
+  // rolling ones are made at the first frame drawn in one pass).
+  ColourProgram colour[2][2][2];
+  bool stochastic = false;  // whether any material is stochastically tiled
+  RollingFrame roll;
+  int group = 0;  // the meshes being drawn (RollingFrame's groups)
   SkyLight sky;
   // The shadow map and the cloud texture, when the world has shadows.
   struct Shadowed {
@@ -494,13 +569,15 @@ struct Renderer::Impl {
     return g;
   }
 
-  // The mesh's chunks in view, adjacent ones merged, in one call.
-  void draw_visible(const GpuMesh& m, const Eigen::Matrix4f& clip_from_model) {
+  // The mesh's chunks in view of any of the clip spaces, adjacent ones merged, in one call.
+  void draw_visible(const GpuMesh& m, const std::vector<Eigen::Matrix4f>& clips_from_model) {
     draw_counts.clear();
     draw_offsets.clear();
     std::size_t end = 0;
     for (const Chunk& c : m.chunks) {
-      if (!in_view(c.box, clip_from_model)) continue;
+      if (std::none_of(clips_from_model.begin(), clips_from_model.end(),
+                       [&](const Eigen::Matrix4f& clip) { return in_view(c.box, clip); }))
+        continue;
       if (!draw_counts.empty() && c.first == end) {
         draw_counts.back() += c.count;
       } else {
@@ -527,9 +604,28 @@ struct Renderer::Impl {
       gl.ActiveTexture(GL_TEXTURE0);
     }
     const Pass pass{colour, P, V, light};
-    draw_meshes(pass, static_meshes, Eigen::Matrix4d::Identity());
-    if (lead_model) draw_meshes(pass, lead_meshes, *lead_model);
-    for (const Eigen::Matrix4d& M : body_models) draw_meshes(pass, body_meshes, M);
+    draw_meshes(pass, static_meshes, Eigen::Matrix4d::Identity(), 0);
+    if (lead_model) draw_meshes(pass, lead_meshes, *lead_model, 1);
+    for (std::size_t i = 0; i < body_models.size(); ++i)
+      draw_meshes(pass, body_meshes, body_models[i], 2 + static_cast<int>(i));
+  }
+
+  // The clip spaces from group g's model under a rolling shutter: its first, middle and last
+  // knots (a chunk in view of none of them is off the image, the readout being short).
+  std::vector<Eigen::Matrix4f> rolling_clips(const Eigen::Matrix4f& P, int g) const {
+    const auto& mv = roll.model_view[static_cast<std::size_t>(g)];
+    std::vector<Eigen::Matrix4f> clips;
+    for (std::size_t k : {std::size_t{0}, mv.size() / 2, mv.size() - 1}) clips.push_back(P * to_float(mv[k]));
+    return clips;
+  }
+
+  void set_rolling(const RollingUniforms& u) {
+    if (!roll.on) return;
+    gl.Uniform1i(u.knots, 4);
+    gl.Uniform1i(u.group, group);
+    gl.Uniform4fv(u.row_of, 1, roll.row_of.data());
+    gl.Uniform4fv(u.dist, 1, roll.dist.data());
+    gl.Uniform1f(u.k3, roll.k3);
   }
 
   struct Pass {
@@ -555,6 +651,7 @@ struct Renderer::Impl {
     gl.Uniform3fv(p.bounce, 1, bounce.data());
     gl.Uniform3fv(p.diffuse, 1, diffuse.data());
     gl.Uniform1i(p.tex, 0);
+    set_rolling(p.roll);
     if (!pass.light) return;
     const Eigen::Matrix4f L = *pass.light * to_float(M), Mf = to_float(M);
     gl.UniformMatrix4fv(p.light_from_model, 1, GL_FALSE, L.data());
@@ -574,7 +671,7 @@ struct Renderer::Impl {
   // one is).
   void bind_material(const GpuMaterial* mat, const Pass& pass, const Eigen::Matrix4d& M,
                      const ColourProgram*& current) {
-    const ColourProgram& p = colour[pass.light ? 1 : 0][mat && mat->cell > 0 ? 1 : 0];
+    const ColourProgram& p = colour[roll.on ? 1 : 0][pass.light ? 1 : 0][mat && mat->cell > 0 ? 1 : 0];
     if (&p != current) use(p, pass, M);
     current = &p;
     gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : white);
@@ -591,26 +688,37 @@ struct Renderer::Impl {
     }
   }
 
-  void draw_meshes(const Pass& pass, const std::vector<GpuMesh>& meshes, const Eigen::Matrix4d& M) {
-    const Eigen::Matrix4f clip_from_model = pass.P * to_float(pass.V * M);
+  // Meshes of group g (RollingFrame) at model matrix M.
+  void draw_meshes(const Pass& pass, const std::vector<GpuMesh>& meshes, const Eigen::Matrix4d& M, int g) {
+    group = g;
+    std::vector<Eigen::Matrix4f> clips =
+        roll.on ? rolling_clips(pass.P, g) : std::vector<Eigen::Matrix4f>{pass.P * to_float(pass.V * M)};
+    for (Eigen::Matrix4f& c : clips) c = cull * c;
     const ColourProgram* current = nullptr;
     if (!pass.colour) {
+      const DepthProgram& d = depth_program[roll.on ? 1 : 0];
       const Eigen::Matrix4f MV = to_float(pass.V * M);
-      gl.UseProgram(depth_program);
-      gl.UniformMatrix4fv(d_proj, 1, GL_FALSE, pass.P.data());
-      gl.UniformMatrix4fv(d_model_view, 1, GL_FALSE, MV.data());
+      gl.UseProgram(d.id);
+      gl.UniformMatrix4fv(d.proj, 1, GL_FALSE, pass.P.data());
+      gl.UniformMatrix4fv(d.model_view, 1, GL_FALSE, MV.data());
+      set_rolling(d.roll);
     }
     for (const auto& m : meshes) {
       if (pass.colour) bind_material(m.material >= 0 ? &materials[m.material] : nullptr, pass, M, current);
-      draw_visible(m, cull * clip_from_model);
+      draw_visible(m, clips);
     }
   }
 
-  // The colour program of one [shadowed][stochastic] pair, with its uniform locations.
-  ColourProgram make_colour_program(bool shadowed, bool stochastic);
+  // The colour program of one [rolling][shadowed][stochastic] triple, with its uniform locations.
+  ColourProgram make_colour_program(bool rolling, bool shadowed, bool stochastic);
+  DepthProgram make_depth_program(bool rolling);
+  // The programs of a frame drawn with (rolling) or without a rolling shutter, made once.
+  void make_programs(bool rolling);
+  // Uploads the view's knots (CameraView::rows) and turns the rolling pass on; off without knots.
+  void begin_rolling(const CameraView& view, const Eigen::Matrix4d& lead_model);
 
   void setup_shadows(int size, const cv::Mat& clouds);
-  Eigen::Matrix4f render_shadow_map(const Eigen::Matrix4f& clip_from_world,
+  Eigen::Matrix4f render_shadow_map(const std::vector<Eigen::Matrix4f>& clips_from_world,
                                     const std::optional<Eigen::Matrix4d>& lead_model);
 
   void check_fbo(const char* what) {
@@ -730,10 +838,13 @@ struct Renderer::Impl {
       if (m.pieces) gl.DeleteTextures(1, &m.pieces);
     }
     gl.DeleteTextures(1, &white);
-    for (auto& row : colour)
-      for (auto& p : row)
-        if (p.id) gl.DeleteProgram(p.id);
-    gl.DeleteProgram(depth_program);
+    if (roll.tex) gl.DeleteTextures(1, &roll.tex);
+    for (auto& by_shadow : colour)
+      for (auto& row : by_shadow)
+        for (auto& p : row)
+          if (p.id) gl.DeleteProgram(p.id);
+    for (auto& d : depth_program)
+      if (d.id) gl.DeleteProgram(d.id);
     if (sh.map) {
       if (sh.clouds) gl.DeleteTextures(1, &sh.clouds);
       gl.DeleteFramebuffers(1, &sh.fbo);
@@ -742,11 +853,43 @@ struct Renderer::Impl {
   }
 };
 
-ColourProgram Renderer::Impl::make_colour_program(bool shadowed, bool stochastic) {
+namespace {
+
+template <class Gl>
+RollingUniforms rolling_uniforms(Gl& gl, GLuint id) {
+  return {gl.GetUniformLocation(id, "u_knots"), gl.GetUniformLocation(id, "u_group"),
+          gl.GetUniformLocation(id, "u_row_of"), gl.GetUniformLocation(id, "u_dist"),
+          gl.GetUniformLocation(id, "u_k3")};
+}
+
+}  // namespace
+
+DepthProgram Renderer::Impl::make_depth_program(bool rolling) {
+  DepthProgram d;
+  d.id = link({kDepthInputs, rolling ? kRollingEye : kOneViewEye, kDepthVs}, {kDepthFs});
+  d.model_view = gl.GetUniformLocation(d.id, "u_model_view");
+  d.proj = gl.GetUniformLocation(d.id, "u_proj");
+  d.roll = rolling_uniforms(gl, d.id);
+  return d;
+}
+
+void Renderer::Impl::make_programs(bool rolling) {
+  const int r = rolling ? 1 : 0;
+  if (depth_program[r].id) return;
+  depth_program[r] = make_depth_program(rolling);
+  for (int shadowed = 0; shadowed < 2; ++shadowed)
+    for (int st = 0; st < 2; ++st)
+      if ((!shadowed || info.light.shadows) && (!st || stochastic))
+        colour[r][shadowed][st] = make_colour_program(rolling, shadowed, st);
+}
+
+ColourProgram Renderer::Impl::make_colour_program(bool rolling, bool shadowed, bool stochastic) {
   ColourProgram p;
   const char* lookup = stochastic ? kStochasticLookup : kImageLookup;
-  p.id = shadowed ? link({kVertexInputs, kShadowedVs}, {lookup, kShadowedFs})
-                  : link({kVertexInputs, kSceneVs}, {lookup, kSceneFs});
+  const char* eye = rolling ? kRollingEye : kOneViewEye;
+  p.id = shadowed ? link({kVertexInputs, eye, kShadowedVs}, {lookup, kShadowedFs})
+                  : link({kVertexInputs, eye, kSceneVs}, {lookup, kSceneFs});
+  p.roll = rolling_uniforms(gl, p.id);
   for (auto [loc, name] : {std::pair{&p.model_view, "u_model_view"}, {&p.proj, "u_proj"}, {&p.model_rot, "u_model_rot"},
                            {&p.tex, "u_tex"}, {&p.to_light, "u_to_light"}, {&p.ambient, "u_ambient"},
                            {&p.bounce, "u_bounce"}, {&p.diffuse, "u_diffuse"}, {&p.unlit, "u_unlit"},
@@ -786,7 +929,7 @@ void Renderer::Impl::setup_shadows(int size, const cv::Mat& clouds) {
 // in the camera's view bound the map sideways (a caster's shadow lies where the caster does in
 // this projection) and every chunk bounds its depth, so casters outside the view still cast.
 // Returns the sun's clip space from the world.
-Eigen::Matrix4f Renderer::Impl::render_shadow_map(const Eigen::Matrix4f& clip_from_world,
+Eigen::Matrix4f Renderer::Impl::render_shadow_map(const std::vector<Eigen::Matrix4f>& clips_from_world,
                                                   const std::optional<Eigen::Matrix4d>& lead_model) {
   const Eigen::Vector3d d = info.light.direction.normalized();
   const Eigen::Vector3d e1 = d.unitOrthogonal(), e2 = d.cross(e1);
@@ -801,8 +944,12 @@ Eigen::Matrix4f Renderer::Impl::render_shadow_map(const Eigen::Matrix4f& clip_fr
       if (in_view_of_camera) side.extend(p.head<2>());
     }
   };
+  auto seen = [&](const Eigen::AlignedBox3f& box) {
+    return std::any_of(clips_from_world.begin(), clips_from_world.end(),
+                       [&](const Eigen::Matrix4f& clip) { return in_view(box, clip); });
+  };
   for (const auto& m : static_meshes)
-    for (const Chunk& c : m.chunks) add(c.box, Eigen::Matrix4d::Identity(), in_view(c.box, clip_from_world));
+    for (const Chunk& c : m.chunks) add(c.box, Eigen::Matrix4d::Identity(), seen(c.box));
   if (lead_model)
     for (const auto& m : lead_meshes)
       for (const Chunk& c : m.chunks) add(c.box, *lead_model, true);
@@ -851,21 +998,14 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   I.info.msaa = scene.msaa;
   I.depth = depth_map(scene.near, scene.far, gl.ClipControl != nullptr);
   I.sky = sky_light(scene.light, scene.light.direction);
-  I.depth_program = I.link({kDepthVs}, {kDepthFs});
-  I.d_model_view = gl.GetUniformLocation(I.depth_program, "u_model_view");
-  I.d_proj = gl.GetUniformLocation(I.depth_program, "u_proj");
   if (scene.light.shadows) I.setup_shadows(scene.light.shadow_map, scene.clouds);
   I.white =
       I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, false, 1);
-  bool stochastic = false;
   for (const auto& m : scene.materials) {
     I.materials.push_back(I.upload_material(m));
-    stochastic = stochastic || I.materials.back().cell > 0;
+    I.stochastic = I.stochastic || I.materials.back().cell > 0;
   }
-  for (int shadowed = 0; shadowed < 2; ++shadowed)
-    for (int st = 0; st < 2; ++st)
-      if ((!shadowed || scene.light.shadows) && (!st || stochastic))
-        I.colour[shadowed][st] = I.make_colour_program(shadowed, st);
+  I.make_programs(false);
   for (const auto& m : scene.static_meshes)
     if (!m.indices.empty()) I.static_meshes.push_back(I.upload_mesh(m, kChunkSize));
   for (const auto& m : scene.lead_meshes)
@@ -914,7 +1054,57 @@ Eigen::Matrix4d model_matrix(const LeadPose& pose) {
   return M;
 }
 
+// World to the camera frame.
+Eigen::Matrix4d view_matrix(const geometry::CameraPose& pose) {
+  Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
+  V.topLeftCorner<3, 3>() = pose.R_CW;
+  V.topRightCorner<3, 1>() = -pose.R_CW * pose.position;
+  return V;
+}
+
 }  // namespace
+
+void Renderer::Impl::begin_rolling(const CameraView& view, const Eigen::Matrix4d& lead_model) {
+  roll.on = false;
+  if (view.rows.empty()) return;
+  make_programs(true);
+  const std::size_t knots = std::max<std::size_t>(view.rows.size(), 2), groups = 2 + body_models.size();
+  roll.model_view.assign(groups, std::vector<Eigen::Matrix4d>(knots));
+  std::vector<float> texels(groups * knots * 12);
+  for (std::size_t k = 0; k < knots; ++k) {
+    const RowKnot& knot = view.rows[std::min(k, view.rows.size() - 1)];
+    const Eigen::Matrix4d V = view_matrix(knot.pose);
+    for (std::size_t g = 0; g < groups; ++g) {
+      Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
+      if (g == 1) M = knot.lead ? model_matrix(*knot.lead) : lead_model;
+      if (g >= 2) M = g - 2 < knot.bodies.size() ? model_matrix(knot.bodies[g - 2]) : body_models[g - 2];
+      roll.model_view[g][k] = V * M;
+      const Eigen::Matrix4f mv = to_float(V * M);
+      float* t = &texels[(g * knots + k) * 12];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) t[4 * r + c] = mv(r, c);
+    }
+  }
+  gl.ActiveTexture(GL_TEXTURE4);
+  if (!roll.tex) {
+    gl.GenTextures(1, &roll.tex);
+    gl.BindTexture(GL_TEXTURE_2D, roll.tex);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  }
+  gl.BindTexture(GL_TEXTURE_2D, roll.tex);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, static_cast<GLsizei>(3 * knots), static_cast<GLsizei>(groups), 0,
+                GL_RGBA, GL_FLOAT, texels.data());
+  gl.ActiveTexture(GL_TEXTURE0);
+  const geometry::PinholeCamera& cam = view.camera;
+  const geometry::Distortion& d = cam.distortion();
+  roll.row_of = Eigen::Vector4d(cam.fy(), cam.cy(), (cam.height() - 1.0) / static_cast<double>(knots - 1),
+                                static_cast<double>(knots - 1))
+                    .cast<float>();
+  roll.dist = Eigen::Vector4d(d.k1, d.k2, d.p1, d.p2).cast<float>();
+  roll.k3 = static_cast<float>(d.k3);
+  roll.on = true;
+}
 
 Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w, int h,
                                const CameraView& view, const std::optional<LeadPose>& lead,
@@ -925,9 +1115,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   Target& t = I.target(w, h);
   const Eigen::Matrix4f P =
       to_float(projection(fx, fy, cx, cy, w, h, I.info.near, I.info.far, I.depth.reversed));
-  Eigen::Matrix4d V = Eigen::Matrix4d::Identity();
-  V.topLeftCorner<3, 3>() = view.pose.R_CW;
-  V.topRightCorner<3, 1>() = -view.pose.R_CW * view.pose.position;
+  const Eigen::Matrix4d V = view_matrix(view.pose);
   std::optional<Eigen::Matrix4d> lead_model;
   if (lead && !I.lead_meshes.empty()) lead_model = model_matrix(*lead);
   I.body_models.clear();
@@ -937,7 +1125,16 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   std::optional<Eigen::Matrix4f> light;
   I.sh.time = view.time;
-  if (I.sh.map) light = I.render_shadow_map(P * to_float(V), lead_model);
+  I.roll.on = false;
+  I.begin_rolling(view, lead_model ? *lead_model : Eigen::Matrix4d::Identity());
+  if (I.sh.map) {
+    // Receivers in view of the first, middle and last rows under a rolling shutter.
+    const std::vector<Eigen::Matrix4f> clips =
+        I.roll.on ? I.rolling_clips(P, 0) : std::vector<Eigen::Matrix4f>{P * to_float(V)};
+    const bool rolling = std::exchange(I.roll.on, false);  // the sun's view is one view
+    light = I.render_shadow_map(clips, lead_model);
+    I.roll.on = rolling;
+  }
   gl.Viewport(0, 0, w, h);
   gl.Enable(GL_DEPTH_TEST);
   gl.DepthFunc(I.depth.reversed ? GL_GREATER : GL_LESS);
@@ -972,6 +1169,7 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   }
   if (regions) gl.Disable(GL_SCISSOR_TEST);
   I.cull = Eigen::Matrix4f::Identity();
+  I.roll.on = false;
   gl.BindVertexArray(0);
   Frame f = regions ? I.read_rects(t, regions->read) : I.read_whole(t);
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
@@ -1044,7 +1242,7 @@ std::optional<LeadSilhouette> Renderer::lead_silhouette(const CameraView& view, 
   gl.Disable(GL_CULL_FACE);
   gl.ClearBufferfv(GL_DEPTH, 0, &I.depth.clear);
   gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-  I.draw_meshes(Impl::Pass{false, P, V, nullptr}, I.lead_meshes, M);
+  I.draw_meshes(Impl::Pass{false, P, V, nullptr}, I.lead_meshes, M, 1);
   gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   gl.BindVertexArray(0);
   LeadSilhouette s;

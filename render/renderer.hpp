@@ -24,6 +24,14 @@
 
 namespace wingman::render {
 
+// One instant of a rolling shutter's readout (CameraView::rows): the camera, the lead and the
+// team's bodies where they are then.
+struct RowKnot {
+  geometry::CameraPose pose;
+  std::optional<LeadPose> lead{};  // nothing: the lead render() is given
+  std::vector<LeadPose> bodies{};  // as CameraView::bodies, in the same order
+};
+
 struct CameraView {
   geometry::PinholeCamera camera;
   geometry::CameraPose pose;
@@ -31,6 +39,12 @@ struct CameraView {
   // Where the team's UAV bodies are (Scene::body_meshes; sim::uav_body_poses): drawn, and casting
   // shadows, at these poses. Empty when the scene has no bodies.
   std::vector<LeadPose> bodies{};
+  // A rolling shutter in one draw: knots spread evenly over the image's rows (the first at row 0,
+  // the last at the bottom row), a row between two knots at the pose interpolated linearly
+  // between theirs; every vertex is drawn from the pose of the image row it lands on, found in the
+  // vertex shader by a few fixed-point steps. `pose`, the lead and `bodies` stay the frame's
+  // instant (shading, the sun's shadow map). Empty: every row at `pose`.
+  std::vector<RowKnot> rows{};
 };
 
 // The lead drawn alone, depth only, over the window of the image plane its model's box projects

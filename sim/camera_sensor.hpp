@@ -22,11 +22,17 @@ struct ShutterSpec {
   double line_delay = 0;
   Readout readout = Readout::TopToBottom;
   // Images averaged over the exposure (odd: the middle one is at mid-exposure, where depth and
-  // the labels are taken).
-  int subframes = 9;
-  // Rolling shutter: rows rendered with one pose. 1 is exact (every row its own time); more is
-  // faster, with a pose error of up to rows_per_band / 2 line delays.
-  int rows_per_band = 1;
+  // the labels are taken); with subframe_motion_px above 0, the most.
+  int subframes = 31;
+  // px of image motion per image: a frame takes as many images as the image motion predicted over
+  // its exposure needs (one when it is under half of this; render/shutter.hpp subframes_for),
+  // capped at `subframes`. 0: always `subframes` images.
+  double subframe_motion_px = 0.5;
+  // Rolling shutter: 0 draws a frame in one pass, each vertex with the pose of the row it lands on
+  // (exact on geometry tessellated finer than the image motion over the readout bends it);
+  // n > 0 draws bands of n rows with one pose each (1: every row its own pose, the reference; more
+  // is off by up to n / 2 line delays).
+  int rows_per_band = 0;
 
   template <class V>
   void visit(V& v) {
@@ -36,7 +42,8 @@ struct ShutterSpec {
     v.choice("readout", readout, {{"top_to_bottom", Readout::TopToBottom}, {"bottom_to_top", Readout::BottomToTop}});
     v("subframes", subframes, geometry::in(1, 255));
     v.check("subframes", subframes % 2 == 1, "must be odd, so that one image lies at mid-exposure");
-    v("rows_per_band", rows_per_band, geometry::in(1, 16384));
+    v("subframe_motion_px", subframe_motion_px, geometry::in(0, 100));
+    v("rows_per_band", rows_per_band, geometry::in(0, 16384));
     v.check("line_delay", type == Type::Global || line_delay > 0, "must be above 0 for a rolling shutter");
   }
   bool rolling() const { return type == Type::Rolling && line_delay > 0; }

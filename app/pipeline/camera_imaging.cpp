@@ -19,6 +19,13 @@ geometry::CameraPose pose_after(const sim::Truth& truth, int uav, double t, cons
   return {truth.camera_R_CW(uav, t + dt), k.position + k.velocity * dt + 0.5 * k.acceleration * dt * dt};
 }
 
+// Image rows between the knots of a rolling shutter drawn in one pass (render::CameraView::rows):
+// the pose's path over 16 rows is a line to within a micrometre and a microradian (a few hundred
+// microseconds of constant acceleration and gimbal motion).
+constexpr int kRowsPerKnot = 16;
+// Pixels between the samples of the middle image that predict the exposure's image motion.
+constexpr int kSmearGridPx = 25;
+
 }  // namespace
 
 geometry::CameraPose true_centre_pose(const sim::Truth& truth, int uav, double t) {
@@ -95,13 +102,83 @@ TakenFrame CameraImaging::take(const sim::Truth& truth, double t, const Draw& dr
   return draw_frame(truth, t, draw);
 }
 
+std::vector<render::RowKnot> CameraImaging::knots(const sim::Truth& truth, double t, const sim::KinematicState& k,
+                                                  double dt) const {
+  const sim::ShutterSpec& s = scn_.uavs[uav_].camera.shutter;
+  const int h = model_.height(), n = std::max(2, (h - 2) / kRowsPerKnot + 2);
+  std::vector<render::RowKnot> out(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double at = dt + render::row_time(s, (h - 1.0) * i / (n - 1), h);
+    out[i] = {pose_after(truth, uav_, t, k, at), sim::lead_pose(truth, t + at, scn_.world),
+              sim::uav_body_poses(truth, t + at, scn_.world)};
+  }
+  return out;
+}
+
+double CameraImaging::predicted_smear(const sim::Truth& truth, double t, const sim::KinematicState& k, double exposure_s,
+                                      const render::Frame& middle) const {
+  const sim::ShutterSpec& s = scn_.uavs[uav_].camera.shutter;
+  const int w = model_.width(), h = model_.height();
+  const double half = exposure_s / 2;
+  double worst = 0;
+  auto moved = [&](const geometry::CameraPose& a, const Eigen::Vector3d& pa, const geometry::CameraPose& b,
+                   const Eigen::Vector3d& pb) {
+    const auto ua = model_.project(a.to_camera(pa)), ub = model_.project(b.to_camera(pb));
+    if (ua && ub) worst = std::max(worst, (*ua - *ub).norm());
+  };
+  // The surface in view, still: each sample pixel's point from its row's pose at mid-exposure.
+  for (int v = kSmearGridPx / 2; v < h; v += kSmearGridPx) {
+    const double tr = render::row_time(s, v, h);
+    const geometry::CameraPose mid = pose_after(truth, uav_, t, k, tr), a = pose_after(truth, uav_, t, k, tr - half),
+                               b = pose_after(truth, uav_, t, k, tr + half);
+    for (int u = kSmearGridPx / 2; u < w; u += kSmearGridPx) {
+      const float z = middle.depth.at<float>(v, u);
+      if (!(z > 0)) continue;
+      const Eigen::Vector2d xn = model_.unproject_normalised(Eigen::Vector2d(u, v));
+      const Eigen::Vector3d p = mid.R_CW.transpose() * (z * xn.homogeneous()) + mid.position;
+      moved(a, p, b, p);
+    }
+  }
+  // What moves of its own: the lead (its reference point and points a height away along and
+  // across it, for its turning) and the team's bodies.
+  const geometry::CameraPose a = pose_after(truth, uav_, t, k, -half), b = pose_after(truth, uav_, t, k, half);
+  const sim::LeadPose la = sim::lead_pose(truth, t - half, scn_.world), lb = sim::lead_pose(truth, t + half, scn_.world);
+  const double r = scn_.world.lead.height;
+  for (const Eigen::Vector2d& off : {Eigen::Vector2d(0, 0), Eigen::Vector2d(r, 0), Eigen::Vector2d(-r, 0),
+                                     Eigen::Vector2d(0, r), Eigen::Vector2d(0, -r)}) {
+    auto at = [&](const sim::LeadPose& l) {
+      const double c = std::cos(l.yaw), sn = std::sin(l.yaw);
+      return Eigen::Vector3d(l.position + Eigen::Vector3d(c * off.x() - sn * off.y(), sn * off.x() + c * off.y(), 0));
+    };
+    moved(a, at(la), b, at(lb));
+  }
+  const auto ba = sim::uav_body_poses(truth, t - half, scn_.world), bb = sim::uav_body_poses(truth, t + half, scn_.world);
+  for (std::size_t i = 0; i < std::min(ba.size(), bb.size()); ++i) moved(a, ba[i].position, b, bb[i].position);
+  return worst;
+}
+
 TakenFrame CameraImaging::draw_frame(const sim::Truth& truth, double t, const Draw& draw) {
   const sim::ShutterSpec& shutter = scn_.uavs[uav_].camera.shutter;
   const sim::KinematicState k = truth.camera(uav_, t);
+  const int w = model_.width(), h = model_.height();
+  auto view_at = [&](double dt) {
+    return render::CameraView{model_, pose_after(truth, uav_, t, k, dt), t + dt,
+                              sim::uav_body_poses(truth, t + dt, scn_.world)};
+  };
+  const auto band = [&](double dt, int row0, int rows) {
+    return draw(view_at(dt), sim::lead_pose(truth, t + dt, scn_.world), row0, rows);
+  };
+  const bool one_pass = shutter.rolling() && shutter.rows_per_band == 0;
+  const auto subframe = [&](double dt) {
+    if (!one_pass) return render::draw_in_bands(shutter, w, h, dt, band);
+    render::CameraView view = view_at(dt);
+    view.rows = knots(truth, t, k, dt);
+    return draw(view, sim::lead_pose(truth, t + dt, scn_.world), 0, h);
+  };
+  const double exposure_s = exposure();
   TakenFrame out;
-  out.frame = render::expose(shutter, exposure(), model_.width(), model_.height(), [&](double dt, int row0, int rows) {
-    return draw({model_, pose_after(truth, uav_, t, k, dt), t + dt, sim::uav_body_poses(truth, t + dt, scn_.world)},
-                sim::lead_pose(truth, t + dt, scn_.world), row0, rows);
+  out.frame = render::expose(exposure_s, subframe, [&](const render::Frame& middle) {
+    return shutter.subframes == 1 ? 1 : render::subframes_for(shutter, predicted_smear(truth, t, k, exposure_s, middle));
   });
   out.poses = true_poses(scn_, truth, uav_, t);
   if (haze_) haze_->apply(out.frame);

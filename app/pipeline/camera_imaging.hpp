@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "datasets/dataset.hpp"
 #include "geometry/frame_poses.hpp"
@@ -67,6 +68,14 @@ class CameraImaging {
   // shutter's otherwise.
   double exposure() const;
   TakenFrame draw_frame(const sim::Truth& truth, double t, const Draw& draw);
+  // A rolling shutter's knots for a frame at t drawn in one pass at sub-frame offset dt (k: the
+  // camera's state at t).
+  std::vector<render::RowKnot> knots(const sim::Truth& truth, double t, const sim::KinematicState& k, double dt) const;
+  // px the image moves over an exposure of exposure_s at t, at most: the surface the middle image
+  // shows (its depth) reprojected from the camera's poses at the exposure's ends, and the lead and
+  // the team's bodies moved along their own paths.
+  double predicted_smear(const sim::Truth& truth, double t, const sim::KinematicState& k, double exposure_s,
+                         const render::Frame& middle) const;
 
   const sim::Scenario& scn_;
   int uav_;
