@@ -25,6 +25,7 @@
 #include "render/gl_context.hpp"
 #include "render/gl_functions.hpp"
 #include "render/renderer.hpp"
+#include "render/sensor.hpp"
 #include "render/scene.hpp"
 #include "sim/scenario.hpp"
 #include "sim/truth.hpp"
@@ -369,6 +370,28 @@ void camera_effect(benchmark::State& state, render::GlBackend backend) {
 }
 
 void BM_CameraEffectEgl(benchmark::State& s) { camera_effect(s, render::GlBackend::Egl); }
+
+// The physical sensor alone (render/sensor.hpp, as effect 4 sets it up) on a 1000 x 1000 frame
+// of the paper camera, an image with every grey level: its cost beside a frame's.
+void BM_SensorModel(benchmark::State& state) {
+  sim::CameraSpec c = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_rendered_fast.yaml").front().uavs[0].camera;
+  set_camera_effect(c, 4);
+  render::SensorModel sensor(c.sensor, c.shutter.exposure, c.camera(), 1, "uav1");
+  render::Frame image;
+  image.rgb.create(c.height, c.width, CV_8UC3);
+  for (int r = 0; r < image.rgb.rows; ++r)
+    for (int col = 0; col < image.rgb.cols; ++col)
+      image.rgb.at<cv::Vec3b>(r, col) = cv::Vec3b(static_cast<uchar>(col % 256), static_cast<uchar>(r % 256), 128);
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) {
+    render::Frame f;
+    f.rgb = image.rgb.clone();
+    sensor.apply(f);
+    benchmark::DoNotOptimize(f.rgb.data);
+  }
+  state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_SensorModel)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_CameraEffectEgl)->DenseRange(0, 11)->ArgName("effect")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_QualitySweepEgl(benchmark::State& s) { quality_sweep(s, render::GlBackend::Egl); }

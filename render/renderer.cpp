@@ -13,224 +13,16 @@
 #include <vector>
 
 #include "render/gl_functions.hpp"
+#include "render/ground_bake.hpp"
 #include "render/piece_table.hpp"
+#include "render/shaders.hpp"
 #include "render/skylight.hpp"
 
 namespace wingman::render {
 
+using namespace shaders;
+
 namespace {
-
-// What both colour programs' vertex shaders read, and the light besides the sun's beam on a face
-// of world normal n: from u_bounce (facing down) to u_ambient (facing up); the two are equal under
-// the constant sky (render/skylight.hpp).
-const char* kVertexInputs = R"(
-layout(location = 0) in vec3 a_pos;
-layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec2 a_uv;
-layout(location = 3) in vec3 a_colour;
-uniform mat4 u_proj;
-uniform mat3 u_model_rot;
-uniform vec3 u_to_light;
-uniform vec3 u_ambient;
-uniform vec3 u_bounce;
-uniform vec3 u_diffuse;
-uniform bool u_unlit;
-out vec2 v_uv;
-vec3 sky(vec3 n) { return u_bounce + (u_ambient - u_bounce) * (0.5 + 0.5 * n.z); }
-)";
-
-// Lambert shading per vertex: the terrain's normals vary smoothly over its 2 m cells and the
-// objects are flat-shaded, so per-pixel lighting changed nothing visible, while llvmpipe's
-// fragment cost grows with every varying and instruction. The fragment shader is one texture
-// lookup times one colour.
-const char* kSceneVs = R"(
-out vec3 v_colour;
-void main() {
-  vec3 n = normalize(u_model_rot * a_normal);
-  vec3 shade = u_unlit ? vec3(1.0) : sky(n) + u_diffuse * max(dot(n, u_to_light), 0.0);
-  v_uv = a_uv;
-  v_colour = a_colour * shade;
-  gl_Position = u_proj * eye(a_pos);
-}
-)";
-
-const char* kSceneFs = R"(
-in vec2 v_uv;
-in vec3 v_colour;
-layout(location = 0) out vec4 o_colour;
-void main() {
-  o_colour = vec4(surface(v_uv) * v_colour, 1.0);
-}
-)";
-
-// The same with the sun's shadow (world.light.shadows): ambient and diffuse light kept apart per
-// vertex, and the diffuse one scaled per pixel by what the shadow map lets through (2x2
-// percentage-closer filtering by the sampler's compare mode). A program of its own, so that a
-// world without shadows runs exactly the programs above.
-const char* kShadowedVs = R"(
-uniform mat4 u_light_from_model;
-uniform mat4 u_model;
-uniform vec2 u_cloud_offset;  // m the clouds have drifted
-uniform float u_cloud_period;  // m the cloud texture spans
-uniform float u_cloud_height;
-out vec3 v_ambient;
-out vec3 v_direct;
-out vec4 v_light;
-out vec2 v_cloud;
-void main() {
-  // Where the ray to the sun crosses the cloud layer.
-  vec3 p = (u_model * vec4(a_pos, 1.0)).xyz;
-  v_cloud = (p.xy + u_to_light.xy * (u_cloud_height - p.z) / max(u_to_light.z, 0.05) - u_cloud_offset) / u_cloud_period;
-  vec3 n = normalize(u_model_rot * a_normal);
-  vec3 direct = u_unlit ? vec3(0.0) : u_diffuse * max(dot(n, u_to_light), 0.0);
-  v_uv = a_uv;
-  v_ambient = a_colour * (u_unlit ? vec3(1.0) : sky(n));
-  v_direct = a_colour * direct;
-  v_light = u_light_from_model * vec4(a_pos, 1.0);
-  gl_Position = u_proj * eye(a_pos);
-}
-)";
-
-const char* kShadowedFs = R"(
-in vec2 v_uv;
-in vec3 v_ambient;
-in vec3 v_direct;
-in vec4 v_light;
-in vec2 v_cloud;
-uniform sampler2DShadow u_shadow;
-uniform sampler2D u_clouds;
-uniform bool u_zero_to_one;
-uniform float u_cloud_block;  // 1 - the direct sun a cloud lets through; 0: no clouds
-layout(location = 0) out vec4 o_colour;
-void main() {
-  vec3 p = v_light.xyz / v_light.w;
-  float lit = texture(u_shadow, vec3(p.xy * 0.5 + 0.5, u_zero_to_one ? p.z : p.z * 0.5 + 0.5));
-  lit *= 1.0 - u_cloud_block * texture(u_clouds, v_cloud).r;
-  o_colour = vec4(surface(v_uv) * (v_ambient + lit * v_direct), 1.0);
-}
-)";
-
-// A surface's colour at texture coordinate uv: the texture as it is.
-const char* kImageLookup = R"(
-uniform sampler2D u_tex;
-vec3 surface(vec2 uv) { return texture(u_tex, uv).rgb; }
-)";
-
-// Stochastic tiling (world.texture.tiling; Heitz & Neyret 2018, in the form of Deliot & Heitz
-// 2019): an equilateral triangle grid over the texture's plane; each grid vertex shows the piece
-// of the image around its centre in u_pieces (render/piece_table.hpp: chosen so that nearby
-// vertices never show copies of the same ground a short way apart, and at least a cell from the
-// image's border so that no piece ever wraps over a seam); each pixel blends the three pieces of
-// its triangle with sharpened barycentric weights, about the image's mean and divided by the
-// weights' norm so that the blend keeps the image's variance. The gradients of the plain
-// coordinate pick the mipmap level (each piece is the same coordinate shifted).
-const char* kStochasticLookup = R"(
-uniform sampler2D u_tex;
-uniform float u_cell;         // grid side, in units of the texture's width
-uniform float u_aspect;       // the texture's height over its width
-uniform float u_sharpness;    // power of the blend weights
-uniform vec3 u_mean;          // the image's mean colour
-uniform sampler2D u_pieces;   // RG32F: each vertex's piece centre, periodic, a power of two wide
-// The shift from the coordinate of vertex `id` to where its piece lies in the image.
-vec2 piece_shift(ivec2 id) {
-  vec2 centre = texelFetch(u_pieces, id & (textureSize(u_pieces, 0) - 1), 0).rg;
-  vec2 at = u_cell * vec2(float(id.x) + 0.5 * float(id.y), 0.8660254 * float(id.y));
-  return centre - at;
-}
-// The lattice's three-colouring: each triangle has one vertex of each colour.
-int colour(ivec2 id) { return (id.x + 2 * id.y + 3000000) % 3; }
-vec3 surface(vec2 uv) {
-  vec2 dx = dFdx(uv), dy = dFdy(uv);
-  vec2 q = vec2(uv.x, uv.y * u_aspect);
-  vec2 g = mat2(1.0, 0.0, -0.57735027, 1.15470054) * (q / u_cell);
-  ivec2 base = ivec2(floor(g));
-  vec2 f = g - floor(g);
-  float z = 1.0 - f.x - f.y;
-  bool lower = z > 0.0;
-  // The triangle's vertices and weights, each in the slot of its colour: across an edge the two
-  // shared vertices keep their slots, so each lookup's coordinate jumps only where its weight is
-  // nought (a 2x2 quad of pixels never filters one lookup from far-apart pieces).
-  ivec2 id[3];
-  vec3 w;
-  ivec2 a = lower ? base : base + ivec2(1, 1), b = base + ivec2(1, 0), c = base + ivec2(0, 1);
-  id[colour(a)] = a;
-  id[colour(b)] = b;
-  id[colour(c)] = c;
-  w[colour(a)] = lower ? z : -z;
-  w[colour(b)] = lower ? f.x : 1.0 - f.y;
-  w[colour(c)] = lower ? f.y : 1.0 - f.x;
-  w = pow(max(w, vec3(1e-4)), vec3(u_sharpness));  // pow(0, k) is undefined under fast math
-  w /= w.x + w.y + w.z;
-  vec2 s = vec2(1.0, 1.0 / u_aspect);
-  vec3 sum = vec3(0.0);
-  for (int k = 0; k < 3; ++k)
-    sum += w[k] * (textureGrad(u_tex, uv + piece_shift(id[k]) * s, dx, dy).rgb - u_mean);
-  return clamp(sum / sqrt(dot(w, w)) + u_mean, 0.0, 1.0);
-}
-)";
-
-// With MSAA, depth comes from a second, single-sample pass of the same geometry with this
-// program (no colour, no texture): the surface at the pixel centre, exactly as without MSAA, never
-// a blend of two surfaces at an edge. Colour is resolved by glBlitFramebuffer. On llvmpipe this
-// costs 12 ms less than one resolve shader averaging the colour samples and picking a depth.
-const char* kDepthInputs = R"(
-layout(location = 0) in vec3 a_pos;
-uniform mat4 u_proj;
-)";
-
-const char* kDepthVs = R"(
-void main() {
-  gl_Position = u_proj * eye(a_pos);
-}
-)";
-
-// A vertex's camera-frame position (every vertex shader's eye()): one model-view for the draw.
-const char* kOneViewEye = R"(
-uniform mat4 u_model_view;
-vec4 eye(vec3 p) { return u_model_view * vec4(p, 1.0); }
-)";
-
-// The same under a rolling shutter drawn in one pass (CameraView::rows): each knot's model-view
-// is three texels of u_knots (row `u_group`: the static scene, the lead, each body); a vertex
-// takes the model-view interpolated at the image row it lands on, found by fixed-point steps from
-// the middle knot (each step moves the row by the image's speed across rows times the line delay,
-// a small fraction of a pixel per pixel, so four steps leave no visible error). The row is the
-// image's (lens distortion applied), not the canvas's a distorted camera is drawn on.
-const char* kRollingEye = R"(
-uniform sampler2D u_knots;   // RGBA32F: knot k's model-view rows 0-2 at texels 3k .. 3k + 2
-uniform int u_group;
-uniform vec4 u_row_of;       // fy, cy, rows between knots, the last knot's index
-uniform vec4 u_dist;         // k1, k2, p1, p2
-uniform float u_k3;
-vec4 at_knot(int k, vec4 p) {
-  return vec4(dot(texelFetch(u_knots, ivec2(3 * k, u_group), 0), p),
-              dot(texelFetch(u_knots, ivec2(3 * k + 1, u_group), 0), p),
-              dot(texelFetch(u_knots, ivec2(3 * k + 2, u_group), 0), p), 1.0);
-}
-float image_row(vec4 e) {
-  vec2 x = clamp(e.xy / max(e.z, 1e-4), vec2(-10.0), vec2(10.0));  // behind the camera: off the image
-  float r2 = dot(x, x);
-  float radial = 1.0 + r2 * (u_dist.x + r2 * (u_dist.y + r2 * u_k3));
-  float y = x.y * radial + u_dist.z * (r2 + 2.0 * x.y * x.y) + 2.0 * u_dist.w * x.x * x.y;
-  return u_row_of.x * y + u_row_of.y;
-}
-vec4 eye(vec3 pos) {
-  vec4 p = vec4(pos, 1.0);
-  float last = u_row_of.w, k = 0.5 * last;
-  vec4 e;
-  for (int i = 0; i < 4; ++i) {
-    float kf = clamp(k, 0.0, last);
-    int k0 = min(int(kf), int(last) - 1);
-    e = mix(at_knot(k0, p), at_knot(k0 + 1, p), kf - float(k0));
-    k = image_row(e) / u_row_of.z;
-  }
-  return e;
-}
-)";
-
-const char* kDepthFs = R"(
-void main() {}
-)";
 
 // A run of triangles of one mesh (a range of its index buffer) and their bounding box.
 struct Chunk {
@@ -477,6 +269,12 @@ struct Renderer::Impl {
     gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
     gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rgba.cols, rgba.rows, 0, GL_RGBA, GL_UNSIGNED_BYTE,
                   rgba.data);
+    set_sampling(repeat, mipmaps, trilinear, anisotropy);
+    return t;
+  }
+
+  // The bound texture's wrapping and filtering (its mipmaps made when it has them).
+  void set_sampling(bool repeat, bool mipmaps, bool trilinear, double anisotropy) {
     const GLint wrap = repeat ? GL_REPEAT : GL_CLAMP_TO_EDGE;
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
@@ -491,7 +289,6 @@ struct Renderer::Impl {
     } else {
       gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     }
-    return t;
   }
 
   GpuMaterial upload_material(const Material& m) {
@@ -522,8 +319,9 @@ struct Renderer::Impl {
     return x;
   }
 
-  // cell: chunk size in metres; 0 for one chunk (the lead, which moves).
-  GpuMesh upload_mesh(const Mesh& m, double cell) {
+  // cell: chunk size in metres; 0 for one chunk (the lead, which moves). bake: the baked ground
+  // the mesh's texture coordinates map into, if its material is one.
+  GpuMesh upload_mesh(const Mesh& m, double cell, const GroundBake* bake = nullptr) {
     GpuMesh g;
     g.material = m.material;
     std::vector<std::uint32_t> indices;
@@ -542,7 +340,10 @@ struct Renderer::Impl {
     for (std::size_t i = 0; i < n; ++i) {
       for (int k = 0; k < 3; ++k) v.push_back(m.positions[3 * i + k]);
       for (int k = 0; k < 3; ++k) v.push_back(m.normals[3 * i + k]);
-      for (int k = 0; k < 2; ++k) v.push_back(m.uvs[2 * i + k]);
+      const Eigen::Vector2d uv(m.uvs[2 * i], m.uvs[2 * i + 1]);
+      const Eigen::Vector2f st = (bake ? bake->map(uv) : uv).cast<float>();
+      v.push_back(st.x());
+      v.push_back(st.y());
       for (int k = 0; k < 3; ++k) v.push_back(m.colours[3 * i + k]);
     }
     gl.GenVertexArrays(1, &g.vao);
@@ -708,6 +509,12 @@ struct Renderer::Impl {
       draw_visible(m, clips);
     }
   }
+
+  // Each stochastically tiled material of the static meshes alone, baked (render/ground_bake.hpp)
+  // where it fits; bakes[i] is material i's, if any.
+  void bake_grounds(const Scene& scene);
+  GLuint bake_ground(const GpuMaterial& live, const GroundBake& plan, const Material& m);
+  std::vector<std::optional<GroundBake>> bakes;
 
   // The colour program of one [rolling][shadowed][stochastic] triple, with its uniform locations.
   ColourProgram make_colour_program(bool rolling, bool shadowed, bool stochastic);
@@ -887,7 +694,9 @@ ColourProgram Renderer::Impl::make_colour_program(bool rolling, bool shadowed, b
   ColourProgram p;
   const char* lookup = stochastic ? kStochasticLookup : kImageLookup;
   const char* eye = rolling ? kRollingEye : kOneViewEye;
-  p.id = shadowed ? link({kVertexInputs, eye, kShadowedVs}, {lookup, kShadowedFs})
+  // Clouds' shadows only where the world has clouds: a lookup and a varying less a pixel.
+  const char* clouds = sh.clouds ? "#define WINGMAN_CLOUDS\n" : "";
+  p.id = shadowed ? link({clouds, kVertexInputs, eye, kShadowedVs}, {clouds, lookup, kShadowedFs})
                   : link({kVertexInputs, eye, kSceneVs}, {lookup, kSceneFs});
   p.roll = rolling_uniforms(gl, p.id);
   for (auto [loc, name] : {std::pair{&p.model_view, "u_model_view"}, {&p.proj, "u_proj"}, {&p.model_rot, "u_model_rot"},
@@ -901,6 +710,79 @@ ColourProgram Renderer::Impl::make_colour_program(bool rolling, bool shadowed, b
                            {&p.mean, "u_mean"}, {&p.pieces, "u_pieces"}})
     *loc = gl.GetUniformLocation(p.id, name);
   return p;
+}
+
+void Renderer::Impl::bake_grounds(const Scene& scene) {
+  GLint max_side = 0;
+  gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_side);
+  bakes.assign(materials.size(), std::nullopt);
+  for (std::size_t i = 0; i < materials.size(); ++i) {
+    if (materials[i].cell <= 0 || !scene.materials[i].bake) continue;
+    const auto uses = [&](const std::vector<Mesh>& meshes) {
+      return std::any_of(meshes.begin(), meshes.end(), [&](const Mesh& m) { return m.material == static_cast<int>(i); });
+    };
+    if (uses(scene.lead_meshes) || uses(scene.body_meshes)) continue;  // on what moves: drawn live
+    Eigen::AlignedBox2d box;
+    for (const Mesh& m : scene.static_meshes)
+      if (m.material == static_cast<int>(i))
+        for (std::size_t k = 0; k + 1 < m.uvs.size(); k += 2) box.extend(Eigen::Vector2d(m.uvs[k], m.uvs[k + 1]));
+    const Material& src = scene.materials[i];
+    const auto plan = plan_ground_bake(box, src.texture.cols, src.texture.rows, max_side);
+    if (!plan) continue;
+    GpuMaterial baked;
+    baked.tex = bake_ground(materials[i], *plan, src);
+    baked.unlit = materials[i].unlit;
+    gl.DeleteTextures(1, &materials[i].tex);
+    gl.DeleteTextures(1, &materials[i].pieces);
+    materials[i] = baked;
+    bakes[i] = plan;
+  }
+}
+
+// The live tiling drawn once over the plan's texels (kBakeFs), then filtered as the material is.
+GLuint Renderer::Impl::bake_ground(const GpuMaterial& live, const GroundBake& plan, const Material& m) {
+  // Half-texel gradients: magnification, so level 0 alone, where the LOD of exactly 0 that the
+  // texel spacing gives may be rounded up into level 1.
+  const GLuint program = link({kBakeVs}, {"#define WINGMAN_GRADIENT_SCALE 0.5\n", kStochasticLookup, kBakeFs});
+  GLuint tex = 0, fbo = 0, vao = 0;
+  gl.GenTextures(1, &tex);
+  gl.BindTexture(GL_TEXTURE_2D, tex);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, plan.width, plan.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  gl.GenFramebuffers(1, &fbo);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+  check_fbo("baked ground");
+  gl.GenVertexArrays(1, &vao);
+  gl.BindVertexArray(vao);
+  gl.Viewport(0, 0, plan.width, plan.height);
+  gl.Disable(GL_DEPTH_TEST);
+  gl.UseProgram(program);
+  const Eigen::Vector2f uv0 = plan.uv0.cast<float>(), texel = plan.density.cwiseInverse().cast<float>();
+  gl.Uniform2fv(gl.GetUniformLocation(program, "u_uv0"), 1, uv0.data());
+  gl.Uniform2fv(gl.GetUniformLocation(program, "u_texel"), 1, texel.data());
+  gl.Uniform1i(gl.GetUniformLocation(program, "u_tex"), 0);
+  gl.Uniform1f(gl.GetUniformLocation(program, "u_cell"), live.cell);
+  gl.Uniform1f(gl.GetUniformLocation(program, "u_aspect"), live.aspect);
+  gl.Uniform1f(gl.GetUniformLocation(program, "u_sharpness"), live.sharpness);
+  gl.Uniform3fv(gl.GetUniformLocation(program, "u_mean"), 1, live.mean.data());
+  gl.Uniform1i(gl.GetUniformLocation(program, "u_pieces"), 3);
+  gl.ActiveTexture(GL_TEXTURE3);
+  gl.BindTexture(GL_TEXTURE_2D, live.pieces);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.BindTexture(GL_TEXTURE_2D, live.tex);
+  // Isotropic footprints: anisotropic filtering would change nothing but llvmpipe's path (the
+  // image is deleted once baked).
+  if (max_aniso > 1) gl.TexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY, 1.f);
+  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  gl.BindVertexArray(0);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl.DeleteFramebuffers(1, &fbo);
+  gl.DeleteVertexArrays(1, &vao);
+  gl.DeleteProgram(program);
+  gl.BindTexture(GL_TEXTURE_2D, tex);
+  set_sampling(false, m.mipmaps, m.trilinear, m.anisotropy);
+  return tex;
 }
 
 void Renderer::Impl::setup_shadows(int size, const cv::Mat& clouds) {
@@ -1001,13 +883,15 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
   if (scene.light.shadows) I.setup_shadows(scene.light.shadow_map, scene.clouds);
   I.white =
       I.upload_texture(cv::Mat(1, 1, CV_8UC3, cv::Scalar(255, 255, 255)), true, false, false, 1);
-  for (const auto& m : scene.materials) {
-    I.materials.push_back(I.upload_material(m));
-    I.stochastic = I.stochastic || I.materials.back().cell > 0;
-  }
+  for (const auto& m : scene.materials) I.materials.push_back(I.upload_material(m));
+  I.bake_grounds(scene);
+  for (const GpuMaterial& m : I.materials) I.stochastic = I.stochastic || m.cell > 0;
   I.make_programs(false);
   for (const auto& m : scene.static_meshes)
-    if (!m.indices.empty()) I.static_meshes.push_back(I.upload_mesh(m, kChunkSize));
+    if (!m.indices.empty()) {
+      const auto& bake = m.material >= 0 ? I.bakes[static_cast<std::size_t>(m.material)] : std::nullopt;
+      I.static_meshes.push_back(I.upload_mesh(m, kChunkSize, bake ? &*bake : nullptr));
+    }
   for (const auto& m : scene.lead_meshes)
     if (!m.indices.empty()) I.lead_meshes.push_back(I.upload_mesh(m, 0));
   for (const auto& m : scene.body_meshes)

@@ -461,6 +461,7 @@ void stochastic_tiling(const sim::TextureSpec& t, std::uint64_t seed, Material& 
   if (t.tiling != sim::TextureSpec::Tiling::Stochastic) return;
   m.stochastic_cell = t.cell;
   m.blend_sharpness = t.blend_sharpness;
+  m.bake = t.bake;
   auto rng = sim::make_stream(seed, "ground_tiling");
   m.stochastic_seed = static_cast<std::uint32_t>(rng());
 }

@@ -27,6 +27,7 @@ struct Material {
   double stochastic_cell = 0;
   double blend_sharpness = 8;
   std::uint32_t stochastic_seed = 0;
+  bool bake = true;  // stochastic: baked into one texture where it fits (render/ground_bake.hpp)
 };
 
 struct Mesh {

@@ -12,9 +12,23 @@
 namespace wingman::render {
 namespace {
 
-constexpr double kPoissonBelow = 30;    // e-: exact Poisson below, its normal limit above
+constexpr float kPoissonBelow = 30;    // e-: exact Poisson below, its normal limit above
 
 double dn_max(const sim::SensorSpec& s) { return std::ldexp(1.0, s.bits) - 1; }
+
+// A Poisson count of mean m (below kPoissonBelow) by inversion of its distribution at uniform u:
+// about m steps of a product and a sum, where std::poisson_distribution sets up a rejection
+// sampler (logarithms, lgamma) at every call.
+int poisson_count(float m, double u) {
+  double p = std::exp(-static_cast<double>(m)), cdf = p;
+  int k = 0;
+  while (u > cdf && k < 4 * static_cast<int>(kPoissonBelow)) {
+    ++k;
+    p *= m / k;
+    cdf += p;
+  }
+  return k;
+}
 
 }  // namespace
 
@@ -60,26 +74,35 @@ double SensorModel::variance_dn(double linear, double pixel_gain, const Exposure
 Exposure SensorModel::apply(Frame& f) {
   const Exposure used = next_;
   if (!physical()) return used;
-  const double top = dn_max(spec_), k = used.gain * top / spec_.full_well;
+  const auto top = static_cast<float>(dn_max(spec_)), k = static_cast<float>(used.gain * dn_max(spec_) / spec_.full_well);
+  const auto ratio = static_cast<float>(spec_.full_well * used.exposure_s / spec_.reference_exposure);
+  const auto dark = static_cast<float>(spec_.dark_current * used.exposure_s);
+  const auto read = static_cast<float>(spec_.read_noise), read2 = read * read;
   const auto& to_linear = linear_of_8bit();
-  cv::Mat shot(f.rgb.size(), CV_32FC3), read(f.rgb.size(), CV_32FC3);
-  cv::RNG noise(rng_());
-  noise.fill(shot, cv::RNG::NORMAL, 0, 1);
-  noise.fill(read, cv::RNG::NORMAL, 0, spec_.read_noise);
-  const double ratio = spec_.full_well * used.exposure_s / spec_.reference_exposure;
-  const double dark = spec_.dark_current * used.exposure_s;
+  // One normal draw a value: shot noise (the Poisson count's normal limit) and read noise are
+  // independent normals, so their sum is one of variance mean + read^2.
+  cv::Mat z(f.rgb.size(), CV_32FC3);
+  cv::RNG(rng_()).fill(z, cv::RNG::NORMAL, 0, 1);
+  std::vector<float> mean(static_cast<std::size_t>(f.rgb.cols) * 3), e(mean.size());
   for (int r = 0; r < f.rgb.rows; ++r) {
     auto* px = f.rgb.ptr<std::uint8_t>(r);
-    const auto* zs = shot.ptr<float>(r);
-    const auto* zr = read.ptr<float>(r);
+    const auto* zr = z.ptr<float>(r);
     const auto* g = pixel_gain_.ptr<float>(r);
     const auto* d = dark_offset_.ptr<float>(r);
-    for (int i = 0; i < f.rgb.cols * 3; ++i) {
-      const double mean = std::max(0.0, to_linear[px[i]] * g[i / 3] * ratio + dark + d[i / 3]);
-      double e = mean < kPoissonBelow ? static_cast<double>(std::poisson_distribution<int>(mean)(rng_))
-                                      : mean + std::sqrt(mean) * zs[i];
-      e += zr[i];
-      const double dn = std::clamp(std::round(e * k), 0.0, top);
+    const int n = f.rgb.cols * 3;
+    for (int c = 0; c < f.rgb.cols; ++c)
+      for (int ch = 0; ch < 3; ++ch) mean[3 * c + ch] = to_linear[px[3 * c + ch]] * (g[c] * ratio) + (dark + d[c]);
+    for (int i = 0; i < n; ++i) {  // vectorised: no branch, no call
+      const float m = std::max(0.f, mean[i]);
+      mean[i] = m;
+      e[i] = m + std::sqrt(m + read2) * zr[i];
+    }
+    // Few electrons: the exact Poisson count, drawn in the values' order.
+    for (int i = 0; i < n; ++i)
+      if (mean[i] < kPoissonBelow)
+        e[i] = static_cast<float>(poisson_count(mean[i], static_cast<double>(rng_() >> 11) * 0x1p-53)) + read * zr[i];
+    for (int i = 0; i < n; ++i) {
+      const float dn = std::clamp(e[i] * k + 0.5f, 0.f, top);  // truncated: rounded, never negative
       px[i] = to_output_[static_cast<std::size_t>(dn)];
     }
   }

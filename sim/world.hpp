@@ -63,6 +63,10 @@ struct TextureSpec {
   Tiling tiling = Tiling::Stochastic;
   double cell = 0.25;
   double blend_sharpness = 8;
+  // Stochastic tiling baked once per world into one texture over the ground, at the image's texel
+  // density (render/ground_bake.hpp: one lookup a pixel where the live tiling takes three); false,
+  // or a ground too large for the bake, draws it live.
+  bool bake = true;
   double detail_min = 0.02;  // m, finest and coarsest detail of the procedural texture
   double detail_max = 0.2;
   int size = 2048;           // px of the procedural texture (one tile, detail_min per texel)
@@ -87,6 +91,7 @@ struct TextureSpec {
     v.choice("tiling", tiling, {{"stochastic", Tiling::Stochastic}, {"repeat", Tiling::Repeat}});
     v("cell", cell, geometry::in(0.05, 0.45));
     v("blend_sharpness", blend_sharpness, geometry::in(1, 64));
+    v("bake", bake);
     v("detail_min", detail_min, geometry::gt(0));
     v("detail_max", detail_max, geometry::gt(0));
     v.check("detail_max", detail_max >= detail_min, "must be at least detail_min");

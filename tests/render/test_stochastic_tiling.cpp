@@ -7,9 +7,11 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
 #include <random>
 
 #include "geometry/rotation.hpp"
+#include "render/ground_bake.hpp"
 #include "render/piece_table.hpp"
 #include "render/renderer.hpp"
 #include "render_test_support.hpp"
@@ -134,8 +136,13 @@ TEST_P(StochasticTilingTest, EachGridVertexShowsTheImageAtItsTablesCentre) {
       const cv::Vec3b got = frame.at<cv::Vec3b>(static_cast<int>(std::lround(px->y())), static_cast<int>(std::lround(px->x())));
       double u, v;
       table.centre(i, j, u, v);
-      // Texel centres carry their index: u = (level + 0.5) / 256 across, v / aspect likewise down.
-      const double want_r = u * 256 - 0.5, want_g = (v / aspect * 192 - 0.5) * 255 / 191;
+      // The piece lies where the table says, its shift rounded to whole blocks of
+      // kBakeBlockTexels texels (kStochasticLookup); texel centres carry their index: u =
+      // (level + 0.5) / 256 across, v / aspect likewise down.
+      const double k = kBakeBlockTexels, at_u = qx * 256, at_v = qy / aspect * 192;
+      const double shown_u = at_u + k * std::round((u * 256 - at_u) / k);
+      const double shown_v = at_v + k * std::round((v / aspect * 192 - at_v) / k);
+      const double want_r = shown_u - 0.5, want_g = (shown_v - 0.5) * 255 / 191;
       worst = std::max({worst, std::abs(got[0] - want_r), std::abs(got[1] - want_g)});
       ++checked;
     }
