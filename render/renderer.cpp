@@ -205,7 +205,15 @@ struct Renderer::Impl {
   struct Shadowed {
     GLuint fbo = 0, map = 0, clouds = 0;
     double time = 0;  // s of the frame being drawn
+    // The map drawn last: its clip space, its casters, its texel (m); and how many were drawn.
+    bool kept = false;
+    Eigen::Matrix4d L = Eigen::Matrix4d::Identity();
+    std::optional<Eigen::Matrix4d> lead;
+    std::vector<Eigen::Matrix4d> bodies;
+    double texel = 0;
+    int drawn = 0;
   } sh;
+  float lead_radius = 0;  // m from the lead's origin to its box's farthest corner
   std::vector<GpuMaterial> materials;
   std::vector<GpuMesh> static_meshes, lead_meshes, body_meshes;
   std::vector<Eigen::Matrix4d> body_models;  // this render's UAV bodies (CameraView::bodies)
@@ -527,6 +535,8 @@ struct Renderer::Impl {
   void setup_shadows(int size, const cv::Mat& clouds);
   Eigen::Matrix4f render_shadow_map(const std::vector<Eigen::Matrix4f>& clips_from_world,
                                     const std::optional<Eigen::Matrix4d>& lead_model);
+  // Whether the kept map holds clip space L with these casters, each within half a texel.
+  bool shadow_map_holds(const Eigen::Matrix4d& L, const std::optional<Eigen::Matrix4d>& lead_model) const;
 
   void check_fbo(const char* what) {
     const GLenum s = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
@@ -785,6 +795,22 @@ GLuint Renderer::Impl::bake_ground(const GpuMaterial& live, const GroundBake& pl
   return tex;
 }
 
+bool Renderer::Impl::shadow_map_holds(const Eigen::Matrix4d& L, const std::optional<Eigen::Matrix4d>& lead_model) const {
+  if (!sh.kept || L != sh.L || lead_model.has_value() != sh.lead.has_value() || body_models.size() != sh.bodies.size())
+    return false;
+  // How far a caster at model matrix A has moved at B, at most: its origin, and its rotation
+  // over its radius.
+  const auto moved = [&](const Eigen::Matrix4d& A, const Eigen::Matrix4d& B, double radius) {
+    return (A.topRightCorner<3, 1>() - B.topRightCorner<3, 1>()).norm() +
+           radius * (A.topLeftCorner<3, 3>() - B.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff() * 3;
+  };
+  const double half = sh.texel / 2;
+  if (lead_model && moved(*lead_model, *sh.lead, lead_radius) >= half) return false;
+  for (std::size_t i = 0; i < body_models.size(); ++i)
+    if (moved(body_models[i], sh.bodies[i], 1.0) >= half) return false;
+  return true;
+}
+
 void Renderer::Impl::setup_shadows(int size, const cv::Mat& clouds) {
   if (!clouds.empty()) sh.clouds = upload_texture(clouds, true, true, true, 1);
   gl.GenTextures(1, &sh.map);
@@ -850,7 +876,11 @@ Eigen::Matrix4f Renderer::Impl::render_shadow_map(const std::vector<Eigen::Matri
   L.block<1, 3>(2, 0) = zs * R.row(2);
   L(2, 3) = depth.reversed ? -zlo * zs : -zlo * zs - 1;
   const Eigen::Matrix4f Lf = to_float(L);
+  if (shadow_map_holds(L, lead_model)) return Lf;
   const int size = info.light.shadow_map;
+  sh.kept = true, sh.L = L, sh.lead = lead_model, sh.bodies = body_models;
+  sh.texel = span.maxCoeff() / size;
+  ++sh.drawn;
   gl.BindFramebuffer(GL_FRAMEBUFFER, sh.fbo);
   gl.Viewport(0, 0, size, size);
   gl.Enable(GL_DEPTH_TEST);
@@ -894,11 +924,17 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
     }
   for (const auto& m : scene.lead_meshes)
     if (!m.indices.empty()) I.lead_meshes.push_back(I.upload_mesh(m, 0));
+  for (const GpuMesh& m : I.lead_meshes)
+    for (const Chunk& c : m.chunks)
+      for (int k = 0; k < 8; ++k)
+        I.lead_radius = std::max(I.lead_radius, c.box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(k)).norm());
   for (const auto& m : scene.body_meshes)
     if (!m.indices.empty()) I.body_meshes.push_back(I.upload_mesh(m, 0));
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)
     throw std::runtime_error("renderer: OpenGL error 0x" + std::to_string(e) + " while uploading the scene");
 }
+
+int Renderer::shadow_maps_drawn() const { return impl_->sh.drawn; }
 
 Renderer::~Renderer() {
   try {
@@ -1012,9 +1048,11 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   I.roll.on = false;
   I.begin_rolling(view, lead_model ? *lead_model : Eigen::Matrix4d::Identity());
   if (I.sh.map) {
-    // Receivers in view of the first, middle and last rows under a rolling shutter.
-    const std::vector<Eigen::Matrix4f> clips =
+    // Receivers in view of the shadow's views, or of this view's first, middle and last rows
+    // under a rolling shutter.
+    std::vector<Eigen::Matrix4f> clips =
         I.roll.on ? I.rolling_clips(P, 0) : std::vector<Eigen::Matrix4f>{P * to_float(V)};
+    if (!view.shadow_views.empty()) clips = shadow_clips(view.shadow_views);
     const bool rolling = std::exchange(I.roll.on, false);  // the sun's view is one view
     light = I.render_shadow_map(clips, lead_model);
     I.roll.on = rolling;
@@ -1182,6 +1220,23 @@ const Renderer::Undistort& Renderer::undistort(const geometry::PinholeCamera& ca
   u->nearest_y = my;
   cv::convertMaps(mx, my, u->map1, u->map2, CV_16SC2);
   return *u;
+}
+
+std::vector<Eigen::Matrix4f> Renderer::shadow_clips(
+    const std::vector<std::pair<geometry::PinholeCamera, geometry::CameraPose>>& views) {
+  std::vector<Eigen::Matrix4f> clips;
+  for (const auto& [cam, pose] : views) {
+    double cx = cam.cx(), cy = cam.cy();
+    int w = cam.width(), h = cam.height();
+    if (!cam.distortion().is_zero()) {  // the canvas a distorted camera is drawn on
+      const Undistort& u = undistort(cam);
+      cx = u.cx, cy = u.cy, w = u.w, h = u.h;
+    }
+    clips.push_back(to_float(projection(cam.fx(), cam.fy(), cx, cy, w, h, impl_->info.near, impl_->info.far,
+                                        impl_->depth.reversed) *
+                             view_matrix(pose)));
+  }
+  return clips;
 }
 
 Frame Renderer::render(const CameraView& view, const std::optional<LeadPose>& lead) {

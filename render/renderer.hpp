@@ -45,6 +45,11 @@ struct CameraView {
   // vertex shader by a few fixed-point steps. `pose`, the lead and `bodies` stay the frame's
   // instant (shading, the sun's shadow map). Empty: every row at `pose`.
   std::vector<RowKnot> rows{};
+  // With the sun's shadows: the views whose receivers bound the shadow map (the team's cameras at
+  // this instant). Views that share them, the lead and the bodies find the same map, which the
+  // renderer keeps and draws again only when its bounds change or a caster has moved half a
+  // texel (Renderer::shadow_maps_drawn). Empty: this view's receivers alone.
+  std::vector<std::pair<geometry::PinholeCamera, geometry::CameraPose>> shadow_views{};
 };
 
 // The lead drawn alone, depth only, over the window of the image plane its model's box projects
@@ -86,6 +91,8 @@ class Renderer {
   std::optional<LeadSilhouette> lead_silhouette(const CameraView& view, const LeadPose& lead,
                                                 int max_side = 2048);
   const GlContext& context() const { return ctx_; }
+  // Shadow maps drawn so far (a frame that found its map kept draws none).
+  int shadow_maps_drawn() const;
 
   // The OpenGL projection matrix for an undistorted w x h image with these intrinsics
   // (camera frame: OpenCV's; exposed for tests). reversed_z: near maps to NDC z 1 and far to 0,
@@ -97,6 +104,9 @@ class Renderer {
   struct Impl;
   struct Undistort;
   const Undistort& undistort(const geometry::PinholeCamera& cam);
+  // The clip spaces of the views a shadow map covers (CameraView::shadow_views).
+  std::vector<Eigen::Matrix4f> shadow_clips(
+      const std::vector<std::pair<geometry::PinholeCamera, geometry::CameraPose>>& views);
   // Part of a frame: the scissor rectangles drawn, and the rectangles read back (inside them).
   struct Regions {
     std::vector<cv::Rect> draw, read;

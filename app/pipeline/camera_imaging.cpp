@@ -1,5 +1,7 @@
 #include "app/pipeline/camera_imaging.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -121,10 +123,13 @@ double CameraImaging::predicted_smear(const sim::Truth& truth, double t, const s
   const int w = model_.width(), h = model_.height();
   const double half = exposure_s / 2;
   double worst = 0;
+  // What is in the image at either end of the exposure (a body beside the camera, far out of
+  // view, sweeps across the image plane).
+  const Eigen::AlignedBox2d image(Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(w - 0.5, h - 0.5));
   auto moved = [&](const geometry::CameraPose& a, const Eigen::Vector3d& pa, const geometry::CameraPose& b,
                    const Eigen::Vector3d& pb) {
     const auto ua = model_.project(a.to_camera(pa)), ub = model_.project(b.to_camera(pb));
-    if (ua && ub) worst = std::max(worst, (*ua - *ub).norm());
+    if (ua && ub && (image.contains(*ua) || image.contains(*ub))) worst = std::max(worst, (*ua - *ub).norm());
   };
   // The surface in view, still: each sample pixel's point from its row's pose at mid-exposure.
   for (int v = kSmearGridPx / 2; v < h; v += kSmearGridPx) {
@@ -161,9 +166,16 @@ TakenFrame CameraImaging::draw_frame(const sim::Truth& truth, double t, const Dr
   const sim::ShutterSpec& shutter = scn_.uavs[uav_].camera.shutter;
   const sim::KinematicState k = truth.camera(uav_, t);
   const int w = model_.width(), h = model_.height();
+  // With shadows, every camera of the team at this instant bounds the sun's map: they, and the
+  // bands and rows of this frame, share one (render::CameraView::shadow_views).
+  std::vector<sim::KinematicState> team;
+  if (scn_.world.light.shadows)
+    for (std::size_t j = 0; j < scn_.uavs.size(); ++j) team.push_back(truth.camera(static_cast<int>(j), t));
   auto view_at = [&](double dt) {
-    return render::CameraView{model_, pose_after(truth, uav_, t, k, dt), t + dt,
-                              sim::uav_body_poses(truth, t + dt, scn_.world)};
+    render::CameraView v{model_, pose_after(truth, uav_, t, k, dt), t + dt, sim::uav_body_poses(truth, t + dt, scn_.world)};
+    for (std::size_t j = 0; j < team.size(); ++j)
+      v.shadow_views.emplace_back(scn_.uavs[j].camera.camera(), pose_after(truth, static_cast<int>(j), t, team[j], dt));
+    return v;
   };
   const auto band = [&](double dt, int row0, int rows) {
     return draw(view_at(dt), sim::lead_pose(truth, t + dt, scn_.world), row0, rows);

@@ -5,8 +5,11 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <cstdio>
+
 #include "geometry/rotation.hpp"
 #include "render/renderer.hpp"
+#include "render/shutter.hpp"
 #include "render_test_support.hpp"
 
 namespace wingman::render {
@@ -150,6 +153,48 @@ TEST_P(ShadowTest, CloudShadowsFallWhereTheSunLooksThroughTheLayerAndDriftWithTh
       EXPECT_NEAR(at(x), u < 20 ? shaded : lit, 3) << "t " << t << ", x " << x;
     }
   }
+}
+
+// A rolling shutter's bands, each with the shadow map of its own rows' receivers, against the
+// same bands sharing the frame's map (CameraView::shadow_views): one map drawn instead of one a
+// band, and the frame within a grey level of the per-band one but on the shadow's edge, where the
+// maps' texels differ.
+TEST_P(ShadowTest, BandsOfOneFrameShareOneShadowMapAndMatchTheirOwnMaps) {
+  WINGMAN_REQUIRE_CONTEXT(GetParam(), ctx);
+  Scene scene = shadow_scene(true);
+  scene.static_meshes.front() = Mesh{};
+  for (int i = 0; i < 30; ++i)  // the ground in 2 m cells: bands see different chunks
+    for (int j = 0; j < 30; ++j) scene.static_meshes.front().append(testing::square({2.0 * i - 29, 2.0 * j - 29, 0}, 2, {1, 1, 1}, 0));
+  scene.static_meshes.front().material = 0;
+  const geometry::PinholeCamera cam(250, 250, 199.5, 199.5, 400, 400);
+  sim::ShutterSpec s;
+  s.type = sim::ShutterSpec::Type::Rolling;
+  s.line_delay = 1e-4;
+  s.rows_per_band = 50;
+  auto pose_at = [](double dt) { return geometry::CameraPose{geometry::nadir_R_CW(), Eigen::Vector3d(2 + 5 * dt, 0, 30)}; };
+  Renderer own(ctx, scene), shared(ctx, scene);
+  const Frame a = expose(s, 0, cam.width(), cam.height(), [&](double dt, int row0, int rows) {
+    return own.render_rows({cam, pose_at(dt)}, std::nullopt, row0, rows);
+  });
+  const Frame b = expose(s, 0, cam.width(), cam.height(), [&](double dt, int row0, int rows) {
+    CameraView v{cam, pose_at(dt)};
+    v.shadow_views = {{cam, pose_at(0)}};
+    return shared.render_rows(v, std::nullopt, row0, rows);
+  });
+  EXPECT_EQ(shared.shadow_maps_drawn(), 1);
+  EXPECT_GE(own.shadow_maps_drawn(), 4);
+  cv::Mat ga, gb, diff;
+  cv::cvtColor(a.rgb, ga, cv::COLOR_RGB2GRAY);
+  cv::cvtColor(b.rgb, gb, cv::COLOR_RGB2GRAY);
+  cv::absdiff(ga, gb, diff);
+  const double within = cv::countNonZero(diff <= 1) / static_cast<double>(diff.total());
+  const double between = 255 * (0.45 + (0.45 + 0.65 * std::sqrt(0.5))) / 2;  // ambient and sunlit
+  const double dark_a = cv::countNonZero(ga < between), dark_b = cv::countNonZero(gb < between);
+  std::printf("maps %d against %d; %.4f within a level; shadow %.0f against %.0f px\n", shared.shadow_maps_drawn(),
+              own.shadow_maps_drawn(), within, dark_b, dark_a);
+  EXPECT_GT(dark_a, 400);  // the box's shadow (4 x 2 m, 550 px) is in view
+  EXPECT_GT(within, 0.99);
+  EXPECT_NEAR(dark_b / dark_a, 1, 0.02);
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, ShadowTest, ::testing::Values(GlBackend::Egl, GlBackend::OsMesa), backend_name);
