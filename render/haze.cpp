@@ -28,7 +28,7 @@ void Haze::apply(Frame& f) const {
       const double t = transmission(z[c] * k[c]);
       for (int ch = 0; ch < 3; ++ch) {
         const double lin = to_linear[px[c][ch]] * t + airlight_[ch] * (1 - t);
-        px[c][ch] = cv::saturate_cast<std::uint8_t>(255 * std::pow(lin, 1 / kRenderedGamma));
+        px[c][ch] = encode_linear(lin);
       }
     }
   }

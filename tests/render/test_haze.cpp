@@ -2,9 +2,12 @@
 // visibility, the airlight fills in the rest, range (not depth) decides it, the sky is untouched.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "render/haze.hpp"
+#include "render/linear_light.hpp"
 
 namespace wingman::render {
 namespace {
@@ -29,6 +32,17 @@ TEST(Haze, SurfacesFadeIntoTheAirlightWithRangeAsKoschmiederSays) {
   EXPECT_NEAR(f.rgb.at<cv::Vec3b>(0, 0)[2], expect(corner, 2), 0.6);
   EXPECT_NE(f.rgb.at<cv::Vec3b>(0, 0)[2], f.rgb.at<cv::Vec3b>(50, 50)[2]);
   EXPECT_EQ(f.rgb.at<cv::Vec3b>(10, 10), cv::Vec3b(200, 200, 200));
+}
+
+TEST(LinearLight, EncodingByItsStepsIsTheGammaCurveRounded) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-0.1, 1.1);
+  for (int i = 0; i < 200000; ++i) {
+    const double lin = u(rng);
+    ASSERT_EQ(encode_linear(lin), cv::saturate_cast<std::uint8_t>(255 * std::pow(std::max(lin, 0.0), 1 / kRenderedGamma)))
+        << lin;
+  }
+  for (int v = 0; v < 256; ++v) EXPECT_EQ(encode_linear(linear_of_8bit()[v]), v);
 }
 
 }  // namespace
