@@ -24,6 +24,7 @@
 #include "bench/process_cpu.hpp"
 #include "render/gl_context.hpp"
 #include "render/gl_functions.hpp"
+#include "render/ground_bake.hpp"
 #include "render/renderer.hpp"
 #include "render/sensor.hpp"
 #include "render/scene.hpp"
@@ -401,6 +402,34 @@ void BM_SensorModel(benchmark::State& state) {
 }
 BENCHMARK(BM_SensorModel)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_CameraEffectEgl)->DenseRange(0, 11)->ArgName("effect")->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// What the stochastic ground's bake costs once per world (render/ground_bake.hpp): a renderer made
+// for scenes/paper_rendered_fast.yaml's world with the bake (argument 1) and without (0), the
+// process's CPU per renderer; `texels`: the bake's size (its plan, over the ground's coordinates).
+void BM_GroundBakeEgl(benchmark::State& state) {
+  sim::Scenario scn = sim::load_scenarios(WINGMAN_SOURCE_DIR "/scenes/paper_rendered_fast.yaml").front();
+  scn.world.texture.bake = state.range(0) == 1;
+  const render::Scene scene = render::build_scene(sim::describe_world(scn));
+  const auto ctx = context_or_skip(state, render::GlBackend::Egl);
+  if (!ctx) return;
+  const double cpu0 = process_cpu_seconds();
+  for (auto _ : state) {
+    render::Renderer renderer(*ctx, scene);
+    benchmark::DoNotOptimize(&renderer);
+  }
+  state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
+  const int ground = scene.static_meshes.front().material;
+  Eigen::AlignedBox2d box;
+  for (const render::Mesh& m : scene.static_meshes)
+    if (m.material == ground)
+      for (std::size_t k = 0; k + 1 < m.uvs.size(); k += 2) box.extend(Eigen::Vector2d(m.uvs[k], m.uvs[k + 1]));
+  const cv::Mat& tex = scene.materials[static_cast<std::size_t>(ground)].texture;
+  if (const auto plan = render::plan_ground_bake(box, tex.cols, tex.rows, 16384)) {
+    state.counters["width"] = plan->width;
+    state.counters["height"] = plan->height;
+  }
+}
+BENCHMARK(BM_GroundBakeEgl)->Arg(0)->Arg(1)->ArgName("bake")->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_QualitySweepEgl(benchmark::State& s) { quality_sweep(s, render::GlBackend::Egl); }
 // Arguments as BM_RenderEgl's. One iteration: 24 frames per setting.

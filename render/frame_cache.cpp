@@ -163,7 +163,7 @@ FrameKeyer::FrameKeyer(const Scene& scene, std::string_view salt) {
     hash_mat(s.get(), m.texture);
     hash_doubles(s.get(), {double(m.repeat), double(m.mipmaps), m.anisotropy, double(m.trilinear), double(m.unlit)});
     if (m.stochastic_cell > 0)  // hashed only when on
-      hash_doubles(s.get(), {m.stochastic_cell, m.blend_sharpness, double(m.stochastic_seed)});
+      hash_doubles(s.get(), {m.stochastic_cell, m.blend_sharpness, double(m.stochastic_seed), double(m.bake)});
   }
   for (const auto* meshes : {&scene.static_meshes, &scene.lead_meshes, &scene.body_meshes}) {
     hash_doubles(s.get(), {double(meshes->size())});
@@ -205,6 +205,11 @@ FrameKey FrameKeyer::key(const CameraView& view, const std::optional<LeadPose>& 
   v.insert(v.end(), p.data(), p.data() + 3);
   if (lead) v.insert(v.end(), {1.0, lead->position.x(), lead->position.y(), lead->position.z(), lead->yaw});
   for (const LeadPose& b : view.bodies) v.insert(v.end(), {2.0, b.position.x(), b.position.y(), b.position.z(), b.yaw});
+  for (const auto& [cam, pose] : view.shadow_views) {  // they bound the sun's shadow map
+    v.insert(v.end(), {3.0, cam.fx(), cam.fy(), cam.cx(), cam.cy(), double(cam.width()), double(cam.height())});
+    v.insert(v.end(), pose.R_CW.data(), pose.R_CW.data() + 9);
+    v.insert(v.end(), pose.position.data(), pose.position.data() + 3);
+  }
   if (timed_) v.push_back(view.time);
   std::vector<std::uint8_t> bytes(sizeof scene + v.size() * sizeof(double));
   std::memcpy(bytes.data(), scene, sizeof scene);

@@ -205,15 +205,13 @@ struct Renderer::Impl {
   struct Shadowed {
     GLuint fbo = 0, map = 0, clouds = 0;
     double time = 0;  // s of the frame being drawn
-    // The map drawn last: its clip space, its casters, its texel (m); and how many were drawn.
+    // The map drawn last: its clip space and its casters; and how many were drawn.
     bool kept = false;
     Eigen::Matrix4d L = Eigen::Matrix4d::Identity();
     std::optional<Eigen::Matrix4d> lead;
     std::vector<Eigen::Matrix4d> bodies;
-    double texel = 0;
     int drawn = 0;
   } sh;
-  float lead_radius = 0;  // m from the lead's origin to its box's farthest corner
   std::vector<GpuMaterial> materials;
   std::vector<GpuMesh> static_meshes, lead_meshes, body_meshes;
   std::vector<Eigen::Matrix4d> body_models;  // this render's UAV bodies (CameraView::bodies)
@@ -535,7 +533,7 @@ struct Renderer::Impl {
   void setup_shadows(int size, const cv::Mat& clouds);
   Eigen::Matrix4f render_shadow_map(const std::vector<Eigen::Matrix4f>& clips_from_world,
                                     const std::optional<Eigen::Matrix4d>& lead_model);
-  // Whether the kept map holds clip space L with these casters, each within half a texel.
+  // Whether the kept map is the one clip space L and these casters draw (the same, bit for bit).
   bool shadow_map_holds(const Eigen::Matrix4d& L, const std::optional<Eigen::Matrix4d>& lead_model) const;
 
   void check_fbo(const char* what) {
@@ -796,19 +794,7 @@ GLuint Renderer::Impl::bake_ground(const GpuMaterial& live, const GroundBake& pl
 }
 
 bool Renderer::Impl::shadow_map_holds(const Eigen::Matrix4d& L, const std::optional<Eigen::Matrix4d>& lead_model) const {
-  if (!sh.kept || L != sh.L || lead_model.has_value() != sh.lead.has_value() || body_models.size() != sh.bodies.size())
-    return false;
-  // How far a caster at model matrix A has moved at B, at most: its origin, and its rotation
-  // over its radius.
-  const auto moved = [&](const Eigen::Matrix4d& A, const Eigen::Matrix4d& B, double radius) {
-    return (A.topRightCorner<3, 1>() - B.topRightCorner<3, 1>()).norm() +
-           radius * (A.topLeftCorner<3, 3>() - B.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff() * 3;
-  };
-  const double half = sh.texel / 2;
-  if (lead_model && moved(*lead_model, *sh.lead, lead_radius) >= half) return false;
-  for (std::size_t i = 0; i < body_models.size(); ++i)
-    if (moved(body_models[i], sh.bodies[i], 1.0) >= half) return false;
-  return true;
+  return sh.kept && L == sh.L && lead_model == sh.lead && body_models == sh.bodies;
 }
 
 void Renderer::Impl::setup_shadows(int size, const cv::Mat& clouds) {
@@ -879,7 +865,6 @@ Eigen::Matrix4f Renderer::Impl::render_shadow_map(const std::vector<Eigen::Matri
   if (shadow_map_holds(L, lead_model)) return Lf;
   const int size = info.light.shadow_map;
   sh.kept = true, sh.L = L, sh.lead = lead_model, sh.bodies = body_models;
-  sh.texel = span.maxCoeff() / size;
   ++sh.drawn;
   gl.BindFramebuffer(GL_FRAMEBUFFER, sh.fbo);
   gl.Viewport(0, 0, size, size);
@@ -924,10 +909,6 @@ Renderer::Renderer(GlContext& ctx, const Scene& scene) : ctx_(ctx), impl_(std::m
     }
   for (const auto& m : scene.lead_meshes)
     if (!m.indices.empty()) I.lead_meshes.push_back(I.upload_mesh(m, 0));
-  for (const GpuMesh& m : I.lead_meshes)
-    for (const Chunk& c : m.chunks)
-      for (int k = 0; k < 8; ++k)
-        I.lead_radius = std::max(I.lead_radius, c.box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(k)).norm());
   for (const auto& m : scene.body_meshes)
     if (!m.indices.empty()) I.body_meshes.push_back(I.upload_mesh(m, 0));
   if (const GLenum e = gl.GetError(); e != GL_NO_ERROR)

@@ -47,8 +47,8 @@ struct CameraView {
   std::vector<RowKnot> rows{};
   // With the sun's shadows: the views whose receivers bound the shadow map (the team's cameras at
   // this instant). Views that share them, the lead and the bodies find the same map, which the
-  // renderer keeps and draws again only when its bounds change or a caster has moved half a
-  // texel (Renderer::shadow_maps_drawn). Empty: this view's receivers alone.
+  // renderer keeps and draws again only when its bounds or a caster's pose change
+  // (Renderer::shadow_maps_drawn). Empty: this view's receivers alone.
   std::vector<std::pair<geometry::PinholeCamera, geometry::CameraPose>> shadow_views{};
 };
 

@@ -236,8 +236,8 @@ void main() {
 }
 )";
 
-// Texel (i, j) is the surface at u_uv0 + (i + 0.5, j + 0.5) * u_texel: one image texel apart, so
-// the lookup's gradients pick the image's own level, as the live tiling's do at that density.
+// Texel (i, j) is the surface at u_uv0 + (i + 0.5, j + 0.5) * u_texel, one image texel apart,
+// read from the image's level 0 (the renderer compiles the lookup with half-texel gradients).
 const char* const kBakeFs = R"(
 uniform vec2 u_uv0;
 uniform vec2 u_texel;
