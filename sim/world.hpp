@@ -208,7 +208,7 @@ struct LightSpec {
   double diffuse = 0.65;
   SunSpec sun{};       // when enabled, it sets the direction
   bool shadows = false;  // what the light does not reach keeps the ambient light only (shadow maps)
-  int shadow_map = 2048;  // px a side of the shadow map, over the camera's view
+  int shadow_map = 2048;  // px a side of the shadow map, over the team's views at one instant
   double haze_visibility = 0;  // m of meteorological visibility (render/haze.hpp); 0: clear air
   CloudSpec clouds{};
   SkylightSpec skylight{};
