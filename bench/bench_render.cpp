@@ -419,12 +419,8 @@ void BM_GroundBakeEgl(benchmark::State& state) {
   }
   state.counters["cpu_ms"] = 1e3 * (process_cpu_seconds() - cpu0) / static_cast<double>(state.iterations());
   const int ground = scene.static_meshes.front().material;
-  Eigen::AlignedBox2d box;
-  for (const render::Mesh& m : scene.static_meshes)
-    if (m.material == ground)
-      for (std::size_t k = 0; k + 1 < m.uvs.size(); k += 2) box.extend(Eigen::Vector2d(m.uvs[k], m.uvs[k + 1]));
   const cv::Mat& tex = scene.materials[static_cast<std::size_t>(ground)].texture;
-  if (const auto plan = render::plan_ground_bake(box, tex.cols, tex.rows, 16384)) {
+  if (const auto plan = render::plan_ground_bake(render::uv_box(scene.static_meshes, ground), tex.cols, tex.rows, 16384)) {
     state.counters["width"] = plan->width;
     state.counters["height"] = plan->height;
   }

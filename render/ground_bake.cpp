@@ -4,6 +4,14 @@
 
 namespace wingman::render {
 
+Eigen::AlignedBox2d uv_box(const std::vector<Mesh>& meshes, int material) {
+  Eigen::AlignedBox2d box;
+  for (const Mesh& m : meshes)
+    if (m.material == material)
+      for (std::size_t k = 0; k + 1 < m.uvs.size(); k += 2) box.extend(Eigen::Vector2d(m.uvs[k], m.uvs[k + 1]));
+  return box;
+}
+
 std::optional<GroundBake> plan_ground_bake(const Eigen::AlignedBox2d& uv_box, int cols, int rows, int max_side) {
   if (uv_box.isEmpty() || cols < 1 || rows < 1) return std::nullopt;
   GroundBake b;

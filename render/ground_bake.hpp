@@ -8,6 +8,9 @@
 #include <Eigen/Geometry>
 
 #include <optional>
+#include <vector>
+
+#include "render/scene.hpp"
 
 namespace wingman::render {
 
@@ -29,6 +32,9 @@ struct GroundBake {
     return (uv - uv0).cwiseProduct(density).cwiseQuotient(Eigen::Vector2d(width, height));
   }
 };
+
+// The texture coordinates of the meshes of material `material`.
+Eigen::AlignedBox2d uv_box(const std::vector<Mesh>& meshes, int material);
 
 // The bake of the texture coordinates in uv_box for an image of cols x rows texels, or nothing
 // when it would be wider or taller than max_side or hold more than kMaxBakedTexels.

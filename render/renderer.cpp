@@ -483,16 +483,19 @@ struct Renderer::Impl {
     current = &p;
     gl.BindTexture(GL_TEXTURE_2D, mat && mat->tex ? mat->tex : white);
     gl.Uniform1i(p.unlit, mat && mat->unlit ? 1 : 0);
-    if (mat && mat->cell > 0) {
-      gl.Uniform1f(p.cell, mat->cell);
-      gl.Uniform1f(p.aspect, mat->aspect);
-      gl.Uniform1f(p.sharpness, mat->sharpness);
-      gl.Uniform3fv(p.mean, 1, mat->mean.data());
-      gl.Uniform1i(p.pieces, 3);
-      gl.ActiveTexture(GL_TEXTURE3);
-      gl.BindTexture(GL_TEXTURE_2D, mat->pieces);
-      gl.ActiveTexture(GL_TEXTURE0);
-    }
+    if (mat && mat->cell > 0) bind_stochastic(p, *mat);
+  }
+
+  // A stochastically tiled material's uniforms and piece table (kStochasticLookup) on p.
+  void bind_stochastic(const ColourProgram& p, const GpuMaterial& mat) {
+    gl.Uniform1f(p.cell, mat.cell);
+    gl.Uniform1f(p.aspect, mat.aspect);
+    gl.Uniform1f(p.sharpness, mat.sharpness);
+    gl.Uniform3fv(p.mean, 1, mat.mean.data());
+    gl.Uniform1i(p.pieces, 3);
+    gl.ActiveTexture(GL_TEXTURE3);
+    gl.BindTexture(GL_TEXTURE_2D, mat.pieces);
+    gl.ActiveTexture(GL_TEXTURE0);
   }
 
   // Meshes of group g (RollingFrame) at model matrix M.
@@ -524,6 +527,8 @@ struct Renderer::Impl {
 
   // The colour program of one [rolling][shadowed][stochastic] triple, with its uniform locations.
   ColourProgram make_colour_program(bool rolling, bool shadowed, bool stochastic);
+  // p's uniform locations by name (-1 for those its program lacks).
+  void locate_uniforms(ColourProgram& p);
   DepthProgram make_depth_program(bool rolling);
   // The programs of a frame drawn with (rolling) or without a rolling shutter, made once.
   void make_programs(bool rolling);
@@ -707,6 +712,11 @@ ColourProgram Renderer::Impl::make_colour_program(bool rolling, bool shadowed, b
   p.id = shadowed ? link({clouds, kVertexInputs, eye, kShadowedVs}, {clouds, lookup, kShadowedFs})
                   : link({kVertexInputs, eye, kSceneVs}, {lookup, kSceneFs});
   p.roll = rolling_uniforms(gl, p.id);
+  locate_uniforms(p);
+  return p;
+}
+
+void Renderer::Impl::locate_uniforms(ColourProgram& p) {
   for (auto [loc, name] : {std::pair{&p.model_view, "u_model_view"}, {&p.proj, "u_proj"}, {&p.model_rot, "u_model_rot"},
                            {&p.tex, "u_tex"}, {&p.to_light, "u_to_light"}, {&p.ambient, "u_ambient"},
                            {&p.bounce, "u_bounce"}, {&p.diffuse, "u_diffuse"}, {&p.unlit, "u_unlit"},
@@ -717,7 +727,6 @@ ColourProgram Renderer::Impl::make_colour_program(bool rolling, bool shadowed, b
                            {&p.cell, "u_cell"}, {&p.aspect, "u_aspect"}, {&p.sharpness, "u_sharpness"},
                            {&p.mean, "u_mean"}, {&p.pieces, "u_pieces"}})
     *loc = gl.GetUniformLocation(p.id, name);
-  return p;
 }
 
 void Renderer::Impl::bake_grounds(const Scene& scene) {
@@ -730,12 +739,9 @@ void Renderer::Impl::bake_grounds(const Scene& scene) {
       return std::any_of(meshes.begin(), meshes.end(), [&](const Mesh& m) { return m.material == static_cast<int>(i); });
     };
     if (uses(scene.lead_meshes) || uses(scene.body_meshes)) continue;  // on what moves: drawn live
-    Eigen::AlignedBox2d box;
-    for (const Mesh& m : scene.static_meshes)
-      if (m.material == static_cast<int>(i))
-        for (std::size_t k = 0; k + 1 < m.uvs.size(); k += 2) box.extend(Eigen::Vector2d(m.uvs[k], m.uvs[k + 1]));
     const Material& src = scene.materials[i];
-    const auto plan = plan_ground_bake(box, src.texture.cols, src.texture.rows, max_side);
+    const auto plan = plan_ground_bake(uv_box(scene.static_meshes, static_cast<int>(i)), src.texture.cols,
+                                       src.texture.rows, max_side);
     if (!plan) continue;
     GpuMaterial baked;
     baked.tex = bake_ground(materials[i], *plan, src);
@@ -765,19 +771,15 @@ GLuint Renderer::Impl::bake_ground(const GpuMaterial& live, const GroundBake& pl
   gl.BindVertexArray(vao);
   gl.Viewport(0, 0, plan.width, plan.height);
   gl.Disable(GL_DEPTH_TEST);
+  ColourProgram p;
+  p.id = program;
+  locate_uniforms(p);
   gl.UseProgram(program);
   const Eigen::Vector2f uv0 = plan.uv0.cast<float>(), texel = plan.density.cwiseInverse().cast<float>();
   gl.Uniform2fv(gl.GetUniformLocation(program, "u_uv0"), 1, uv0.data());
   gl.Uniform2fv(gl.GetUniformLocation(program, "u_texel"), 1, texel.data());
-  gl.Uniform1i(gl.GetUniformLocation(program, "u_tex"), 0);
-  gl.Uniform1f(gl.GetUniformLocation(program, "u_cell"), live.cell);
-  gl.Uniform1f(gl.GetUniformLocation(program, "u_aspect"), live.aspect);
-  gl.Uniform1f(gl.GetUniformLocation(program, "u_sharpness"), live.sharpness);
-  gl.Uniform3fv(gl.GetUniformLocation(program, "u_mean"), 1, live.mean.data());
-  gl.Uniform1i(gl.GetUniformLocation(program, "u_pieces"), 3);
-  gl.ActiveTexture(GL_TEXTURE3);
-  gl.BindTexture(GL_TEXTURE_2D, live.pieces);
-  gl.ActiveTexture(GL_TEXTURE0);
+  gl.Uniform1i(p.tex, 0);
+  bind_stochastic(p, live);
   gl.BindTexture(GL_TEXTURE_2D, live.tex);
   // Isotropic footprints: anisotropic filtering would change nothing but llvmpipe's path (the
   // image is deleted once baked).
@@ -1026,7 +1028,6 @@ Frame Renderer::render_pinhole(double fx, double fy, double cx, double cy, int w
   if (I.depth.reversed) gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   std::optional<Eigen::Matrix4f> light;
   I.sh.time = view.time;
-  I.roll.on = false;
   I.begin_rolling(view, lead_model ? *lead_model : Eigen::Matrix4d::Identity());
   if (I.sh.map) {
     // Receivers in view of the shadow's views, or of this view's first, middle and last rows
